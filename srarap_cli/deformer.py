@@ -1,0 +1,211 @@
+"""Deformer: precompute once per mesh and constraint set, then solve for any targets."""
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse.csgraph as csgraph
+
+from .energy import bending_energy, membrane_energy
+from .global_step import PoissonSolver
+from .local_step.linear import LinearRotorStep
+from .local_step.membrane import cell_covariance
+from .operators import cell_graph
+from .quaternion import IDENTITY
+
+LOG_FIELDS = ("iteration", "membrane", "bending", "total", "rel_change", "max_move", "seconds")
+
+
+class NumericalError(RuntimeError):
+    """The solve produced non-finite values."""
+
+
+@dataclass
+class DeformResult:
+    """Outcome of :meth:`Deformer.solve`.
+
+    Attributes
+    ----------
+    positions : (n, 3) float array
+    rotors : (n, 4) float array, unit quaternions (w, x, y, z) of the vertex cells
+    log : list of dict, one per iteration (0 is the Laplacian-editing start), keys LOG_FIELDS
+    converged : bool, relative energy change fell below ``tol``
+    iterations : int, local/global iterations run
+    """
+
+    positions: np.ndarray
+    rotors: np.ndarray
+    log: list = field(default_factory=list)
+    converged: bool = False
+    iterations: int = 0
+
+    @property
+    def energy(self):
+        return self.log[-1]["total"]
+
+
+class Deformer:
+    """SR-ARAP deformation of one triangle mesh with one set of constrained vertices.
+
+    Builds the edge weights, factors the Poisson matrix and lays out the rotor system once;
+    :meth:`solve` then runs the local/global iteration for any target positions.
+
+    Parameters
+    ----------
+    V : (n, 3) float array, rest positions
+    F : (f, 3) int array, triangles
+    constrained : (k,) int array, ids of vertices whose positions are prescribed
+    alpha : float > 0, bending weight (energy uses ``alpha * area``)
+    feedback : float >= 0, pull of each rotor toward its previous value (paper's eps)
+    weights : {"cotan-clamped", "cotan", "uniform"}
+    area : float, optional; ``A`` in the energy, default the surface area of (V, F)
+
+    Attributes
+    ----------
+    auto_fixed : (j,) int array
+        Vertices kept at rest because nothing could move them: unreferenced vertices and
+        every connected part that holds no constrained vertex.
+    warnings : list of str
+
+    Examples
+    --------
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    >>> F = np.array([[0, 1, 2], [1, 3, 2]])
+    >>> d = Deformer(V, F, constrained=[0, 1, 2, 3])
+    >>> r = d.solve(V + [0, 0, 1])
+    >>> r.converged, np.allclose(r.positions, V + [0, 0, 1])
+    (True, True)
+    """
+
+    def __init__(self, V, F, constrained, *, alpha=0.14, feedback=0.2,
+                 weights="cotan-clamped", area=None):
+        if not alpha > 0:
+            raise ValueError("alpha must be > 0")
+        if not feedback >= 0:
+            raise ValueError("feedback must be >= 0")
+        self.V = np.asarray(V, dtype=float)
+        self.F = np.asarray(F, dtype=np.int64)
+        self.graph = cell_graph(self.V, self.F, weights)
+        self.alpha = float(alpha)
+        self.area = self.graph.area if area is None else float(area)
+        self.constrained = np.asarray(constrained, dtype=np.int64).ravel()
+        mask = np.zeros(len(self.V), dtype=bool)
+        mask[self.constrained] = True
+        self.warnings = []
+        self.auto_fixed = self._unanchored(mask)
+        mask[self.auto_fixed] = True
+        self._mask = mask
+        self._fixed = np.flatnonzero(mask)
+        self._slot = np.searchsorted(self._fixed, self.constrained)
+        q = self.V[self.graph.J] - self.V[self.graph.I]
+        self._rest_edges = q
+        self._rest_sq = np.einsum("ij,ij->i", q, q)
+        self._energy_floor = 1e-14 * max(float(self.graph.c @ self._rest_sq), 1e-300)
+        self.poisson = PoissonSolver(self.graph, mask)
+        self.local_step = LinearRotorStep(self.graph, mask, self.alpha * self.area, feedback)
+
+    def _unanchored(self, mask):
+        n_parts, label = csgraph.connected_components(self.graph.laplacian, directed=False)
+        anchored = np.zeros(n_parts, dtype=bool)
+        anchored[label[mask]] = True
+        lonely = np.flatnonzero(self.graph.degree == 0)
+        floating = np.flatnonzero(~anchored[label] & (self.graph.degree > 0))
+        if lonely.size:
+            self.warnings.append(f"{lonely.size} unreferenced vertices kept at rest")
+        if floating.size:
+            parts = np.unique(label[floating]).size
+            self.warnings.append(f"{parts} connected part(s) without a constrained vertex "
+                                 f"({floating.size} vertices) kept at rest")
+        return np.union1d(lonely, floating)
+
+    def _fixed_targets(self, targets):
+        full = self.V[self._fixed].copy()
+        full[self._slot] = targets
+        return full
+
+    def energies(self, P, R):
+        """(membrane, bending) energy of positions ``P`` with rotors ``R``."""
+        return (membrane_energy(self.graph, self._rest_edges, P, R),
+                bending_energy(self.graph, R, self.alpha, self.area))
+
+    def solve(self, targets, *, max_iter=200, tol=1e-6, initial=None, callback=None):
+        """Deform toward ``targets`` for the constrained vertices.
+
+        Parameters
+        ----------
+        targets : (k, 3) float array, in the order of ``constrained``
+        max_iter : int >= 0, local/global iterations at most
+        tol : float, stop when ``|E_k - E_{k-1}| <= tol * E_{k-1}``
+        initial : (positions (n, 3), rotors (n, 4)), optional warm start; default is
+            Laplacian editing (identity rotors, one Poisson solve)
+        callback : callable(dict), called with each log row
+
+        Returns
+        -------
+        DeformResult
+        """
+        start = time.perf_counter()
+        targets = np.asarray(targets, dtype=float).reshape(-1, 3)
+        fixed_targets = self._fixed_targets(targets)
+        if initial is None:
+            R = np.tile(IDENTITY, (len(self.V), 1))
+            P = self.poisson.solve(self.poisson.rotated_divergence(self._rest_edges, R),
+                                   fixed_targets)
+        else:
+            P = np.array(initial[0], dtype=float)
+            R = np.array(initial[1], dtype=float)
+            P[self._fixed] = fixed_targets
+        result = DeformResult(P, R)
+        self._record(result, P, R, None, start, callback)
+        for k in range(1, max_iter + 1):
+            S, s = cell_covariance(self.graph, self._rest_edges, self._rest_sq, P)
+            R = self.local_step(S, s, R)
+            P_new = self.poisson.solve(self.poisson.rotated_divergence(self._rest_edges, R),
+                                       fixed_targets)
+            row = self._record(result, P_new, R, P, start, callback)
+            P = P_new
+            result.iterations = k
+            if row["rel_change"] <= tol:
+                result.converged = True
+                break
+        result.positions, result.rotors = P, R
+        return result
+
+    def _record(self, result, P, R, P_prev, start, callback):
+        membrane, bending = self.energies(P, R)
+        total = membrane + bending
+        if not np.isfinite(total):
+            raise NumericalError(f"energy became non-finite at iteration {len(result.log)}")
+        if P_prev is None:
+            rel, move = float("nan"), 0.0
+        else:
+            previous = result.log[-1]["total"]
+            rel = abs(total - previous) / max(previous, self._energy_floor)
+            move = float(np.sqrt(np.max(np.sum((P - P_prev) ** 2, axis=1), initial=0.0)))
+        row = dict(iteration=len(result.log), membrane=membrane, bending=bending, total=total,
+                   rel_change=rel, max_move=move, seconds=time.perf_counter() - start)
+        result.log.append(row)
+        if callback is not None:
+            callback(row)
+        return row
+
+
+def deform(V, F, constrained, targets, **options):
+    """One-shot deformation: build a :class:`Deformer` and solve once.
+
+    Parameters
+    ----------
+    V : (n, 3) float array
+    F : (f, 3) int array
+    constrained : (k,) int array
+    targets : (k, 3) float array
+    **options : ``alpha``, ``feedback``, ``weights``, ``area`` go to the Deformer;
+        ``max_iter``, ``tol``, ``initial``, ``callback`` to :meth:`Deformer.solve`
+
+    Returns
+    -------
+    DeformResult
+    """
+    solve_keys = {"max_iter", "tol", "initial", "callback"}
+    solve_opts = {k: v for k, v in options.items() if k in solve_keys}
+    build_opts = {k: v for k, v in options.items() if k not in solve_keys}
+    return Deformer(V, F, constrained, **build_opts).solve(targets, **solve_opts)
