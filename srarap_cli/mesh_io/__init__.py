@@ -1,0 +1,142 @@
+"""Read and write meshes, keeping vertex order, polygons, UVs and normals.
+
+OBJ and OFF are parsed here (meshio fails on common variants of both); PLY and STL are
+read with meshio. Writers are deterministic (no timestamps) and atomic (temporary file in
+the target folder, then rename), so a failed run never leaves a partial file behind.
+"""
+import os
+import tempfile
+import warnings
+
+import meshio
+import numpy as np
+
+from ..errors import InputError, OutputError
+from .mesh import Mesh
+from .normals import recompute_normals
+from .obj import format_obj, read_obj
+from .off import format_off, read_off
+from .ply import format_ply, mesh_from_meshio, per_vertex
+
+READ_FORMATS = (".obj", ".off", ".ply", ".stl")
+WRITE_FORMATS = (".obj", ".off", ".ply")
+
+__all__ = ["Mesh", "read_mesh", "write_mesh", "atomic_write", "READ_FORMATS", "WRITE_FORMATS"]
+
+
+def _suffix(path):
+    return os.path.splitext(str(path))[1].lower()
+
+
+def read_mesh(path):
+    """Read OBJ, OFF, PLY or STL into a :class:`Mesh`.
+
+    Raises
+    ------
+    InputError : the file is missing, unreadable, of another format or invalid.
+    """
+    suffix = _suffix(path)
+    if suffix not in READ_FORMATS:
+        raise InputError(f"{path}: unsupported mesh format {suffix or '(none)'!r}; "
+                         f"use one of {', '.join(READ_FORMATS)}")
+    try:
+        if suffix == ".obj":
+            mesh = read_obj(path)
+        elif suffix == ".off":
+            mesh = read_off(path)
+        else:
+            mesh = _read_meshio(path, suffix)
+    except InputError:
+        raise
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    _validate(mesh, path)
+    return mesh
+
+
+def _read_meshio(path, suffix):
+    if not os.path.isfile(path):
+        raise InputError(f"{path}: no such file")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            m = meshio.read(path, file_format="ply" if suffix == ".ply" else "stl")
+    except Exception as exc:  # meshio raises many types for malformed files
+        raise InputError(f"{path}: not a readable {suffix[1:].upper()} file ({exc})") from None
+    return mesh_from_meshio(m)
+
+
+def _validate(mesh, path):
+    n = len(mesh.vertices)
+    if n == 0 or mesh.face_sizes.size == 0:
+        raise InputError(f"{path}: mesh has no {'vertices' if n == 0 else 'faces'}")
+    if not np.isfinite(mesh.vertices).all():
+        bad = int(np.flatnonzero(~np.isfinite(mesh.vertices).all(axis=1))[0])
+        raise InputError(f"{path}: vertex {bad} has a NaN or infinite coordinate")
+    fv = mesh.face_vertices
+    if fv.min() < 0 or fv.max() >= n:
+        raise InputError(f"{path}: a face references vertex "
+                         f"{int(fv.min() if fv.min() < 0 else fv.max())}, "
+                         f"but the mesh has vertices 0..{n - 1}")
+
+
+def format_mesh(mesh, suffix):
+    """File content for ``mesh`` in the format of ``suffix``, with warnings for lost data."""
+    lost = []
+    if suffix == ".obj":
+        return format_obj(mesh).encode("utf-8"), lost
+    if mesh.uv is not None and (suffix == ".off" or per_vertex(mesh, mesh.uv, mesh.face_uv) is None):
+        lost.append(f"texture coordinates not written: {suffix[1:].upper()} stores at most one "
+                    "per vertex; write .obj to keep them")
+    if mesh.normals is not None and per_vertex(mesh, mesh.normals, mesh.face_normals) is None:
+        mesh = _vertex_normals(mesh)
+    if suffix == ".off":
+        return format_off(mesh).encode("ascii"), lost
+    return format_ply(mesh), lost
+
+
+def _vertex_normals(mesh):
+    """Per-corner normals (OBJ) become per-vertex normals for formats that only have those."""
+    out = Mesh(**{k: getattr(mesh, k) for k in mesh.__dataclass_fields__})
+    out.normals = np.zeros_like(mesh.vertices)
+    out.face_normals = mesh.face_vertices
+    out.normals = recompute_normals(out)
+    return out
+
+
+def write_mesh(path, mesh):
+    """Write ``mesh`` to ``path`` (format from the extension) atomically.
+
+    Returns
+    -------
+    list of str : warnings about data the format cannot hold
+    """
+    suffix = _suffix(path)
+    if suffix not in WRITE_FORMATS:
+        raise OutputError(f"{path}: cannot write {suffix or 'files without extension'}; "
+                          f"use one of {', '.join(WRITE_FORMATS)}")
+    data, lost = format_mesh(mesh, suffix)
+    atomic_write(path, data)
+    return lost
+
+
+def atomic_write(path, data):
+    """Write bytes to ``path`` via a temporary file in the same folder and a rename."""
+    folder = os.path.dirname(os.path.abspath(path))
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".srarap-", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write: {exc.strerror}") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException as exc:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise OutputError(f"{path}: cannot write: {exc.strerror}") from None
+        raise

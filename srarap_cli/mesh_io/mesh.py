@@ -1,0 +1,55 @@
+"""The polygon mesh record every reader fills and every writer consumes."""
+from dataclasses import dataclass, field
+
+import igl
+import numpy as np
+
+
+@dataclass
+class Mesh:
+    """A polygon mesh as read from a file, kept close to the file's own structure.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float array, in file order
+    face_sizes : (k,) int array, corners per polygon
+    face_vertices : (c,) int array, corner vertex ids, polygons one after another
+    uv : (t, d) float array or None, texture coordinates (OBJ ``vt``, PLY ``s t``)
+    face_uv : (c,) int array or None, per-corner index into ``uv`` (-1 where a corner has none)
+    normals : (m, 3) float array or None
+    face_normals : (c,) int array or None, per-corner index into ``normals`` (-1: none)
+    vertex_data : dict of name -> (n,) array, other per-vertex properties (PLY)
+    statements : list of (int, str), OBJ lines kept verbatim (``mtllib``, ``usemtl``, ``g``,
+        ``s``, ...) with the number of faces that preceded them
+    """
+
+    vertices: np.ndarray
+    face_sizes: np.ndarray
+    face_vertices: np.ndarray
+    uv: np.ndarray = None
+    face_uv: np.ndarray = None
+    normals: np.ndarray = None
+    face_normals: np.ndarray = None
+    vertex_data: dict = field(default_factory=dict)
+    statements: list = field(default_factory=list)
+
+    @property
+    def face_offsets(self):
+        """(k + 1,) cumulative corner offsets: polygon f is ``face_vertices[o[f]:o[f+1]]``."""
+        return np.concatenate([[0], np.cumsum(self.face_sizes)]).astype(np.int64)
+
+    def triangles(self):
+        """Fan triangulation for the solve: ``F`` (f, 3) and the polygon of each triangle."""
+        if self.face_sizes.size and self.face_sizes.min() == self.face_sizes.max() == 3:
+            return self.face_vertices.reshape(-1, 3), np.arange(self.face_sizes.size)
+        F, J = igl.polygons_to_triangles(self.face_vertices.astype(np.int64), self.face_offsets)
+        return F, J
+
+    def with_vertices(self, vertices):
+        """A copy with new positions and normals recomputed for them."""
+        from .normals import recompute_normals
+        out = Mesh(**{k: getattr(self, k) for k in self.__dataclass_fields__})
+        out.vertices = np.asarray(vertices, dtype=float)
+        if out.normals is not None:
+            out.normals = recompute_normals(out)
+        return out

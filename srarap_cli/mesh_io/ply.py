@@ -1,0 +1,86 @@
+"""PLY (read through meshio, written here) and STL (read through meshio).
+
+meshio stamps the current time into PLY headers it writes; this writer does not, so the
+same mesh always gives the same bytes.
+"""
+import numpy as np
+
+from .mesh import Mesh
+
+_UV_NAMES = (("s", "t"), ("u", "v"), ("texture_u", "texture_v"))
+_PLY_TYPES = {"u1": "uchar", "i1": "char", "u2": "ushort", "i2": "short", "u4": "uint",
+              "i4": "int", "f4": "float", "f8": "double"}
+
+
+def mesh_from_meshio(m):
+    """Convert a ``meshio.Mesh`` to :class:`Mesh`, polygon blocks kept in file order."""
+    blocks = [c.data for c in m.cells if c.type in ("triangle", "quad", "polygon")]
+    sizes = np.concatenate([np.full(len(b), b.shape[1]) for b in blocks]) if blocks else []
+    corners = np.concatenate([b.ravel() for b in blocks]) if blocks else []
+    mesh = Mesh(vertices=np.asarray(m.points, dtype=float)[:, :3],
+                face_sizes=np.asarray(sizes, dtype=np.int64),
+                face_vertices=np.asarray(corners, dtype=np.int64))
+    data = dict(m.point_data)
+    if all(k in data for k in ("nx", "ny", "nz")):
+        mesh.normals = np.column_stack([data.pop(k) for k in ("nx", "ny", "nz")]).astype(float)
+        mesh.face_normals = mesh.face_vertices.copy()
+    for a, b in _UV_NAMES:
+        if a in data and b in data:
+            mesh.uv = np.column_stack([data.pop(a), data.pop(b)]).astype(float)
+            mesh.face_uv = mesh.face_vertices.copy()
+            break
+    mesh.vertex_data = {k: np.asarray(v) for k, v in data.items() if np.ndim(v) == 1}
+    return mesh
+
+
+def per_vertex(mesh, values, refs):
+    """``values`` as one row per vertex, or None when corners of a vertex disagree."""
+    if values is None:
+        return None
+    n = len(mesh.vertices)
+    ok = refs >= 0
+    if not ok.all():
+        return None
+    first = np.full(n, -1)
+    first[mesh.face_vertices[::-1]] = refs[::-1]
+    if (first[mesh.face_vertices] != refs).any() or (first < 0).any():
+        return None
+    return values[first]
+
+
+def format_ply(mesh):
+    """Binary little-endian PLY bytes; per-vertex normals and UVs when they are per vertex."""
+    n = len(mesh.vertices)
+    columns = [("x", mesh.vertices[:, 0]), ("y", mesh.vertices[:, 1]), ("z", mesh.vertices[:, 2])]
+    normals = per_vertex(mesh, mesh.normals, mesh.face_normals)
+    if normals is not None:
+        columns += list(zip(("nx", "ny", "nz"), normals.T))
+    uv = per_vertex(mesh, mesh.uv, mesh.face_uv)
+    if uv is not None:
+        columns += list(zip(("s", "t"), uv[:, :2].T))
+    columns += [(k, v) for k, v in sorted(mesh.vertex_data.items())
+                if v.dtype.str[1:] in _PLY_TYPES]
+    dtype = [(name, "<" + (np.asarray(col).dtype.str[1:] if name in mesh.vertex_data else "f8"))
+             for name, col in columns]
+    table = np.empty(n, dtype=dtype)
+    for name, col in columns:
+        table[name] = col
+    header = ["ply", "format binary_little_endian 1.0", "comment written by srarap",
+              f"element vertex {n}"]
+    header += [f"property {_PLY_TYPES[table.dtype[name].str[1:]]} {name}" for name, _ in columns]
+    header += [f"element face {mesh.face_sizes.size}",
+               "property list uchar int vertex_indices", "end_header"]
+    return ("\n".join(header) + "\n").encode("ascii") + table.tobytes() + _face_bytes(mesh)
+
+
+def _face_bytes(mesh):
+    """Each polygon as a uint8 corner count followed by int32 vertex ids."""
+    sizes = mesh.face_sizes
+    start = np.concatenate([[0], np.cumsum(1 + 4 * sizes)[:-1]]).astype(np.int64)
+    buf = np.zeros(int((1 + 4 * sizes).sum()), dtype=np.uint8)
+    buf[start] = sizes.astype(np.uint8)
+    local = np.arange(mesh.face_vertices.size) - np.repeat(mesh.face_offsets[:-1], sizes)
+    pos = np.repeat(start, sizes) + 1 + 4 * local
+    idx = mesh.face_vertices.astype("<i4").view(np.uint8).reshape(-1, 4)
+    buf[pos[:, None] + np.arange(4)] = idx
+    return buf.tobytes()
