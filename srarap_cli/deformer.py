@@ -91,6 +91,9 @@ class Deformer:
         mask = np.zeros(len(self.V), dtype=bool)
         mask[self.constrained] = True
         self.warnings = []
+        if self.graph.degenerate:
+            self.warnings.append(f"{self.graph.degenerate} triangle angles of zero-area faces "
+                                 "have no finite cotangent; their weights count as 0")
         self.auto_fixed = self._unanchored(mask)
         mask[self.auto_fixed] = True
         self._mask = mask

@@ -28,6 +28,8 @@ class CellGraph:
         Total surface area of the mesh.
     incidence : (n, m) sparse matrix
         Ones at ``(I[e], e)``: sums per-edge values into their source vertex.
+    degenerate : int
+        Triangle angles whose cotangent was not finite (zero-area faces); they count as 0.
     """
 
     I: np.ndarray
@@ -37,6 +39,7 @@ class CellGraph:
     laplacian: sp.csr_matrix
     area: float
     incidence: sp.csr_matrix
+    degenerate: int = 0
 
     @property
     def n(self):
@@ -46,6 +49,11 @@ class CellGraph:
         """Sum per-edge ``values`` of shape (m, ...) into their source vertex: (n, ...)."""
         flat = values.reshape(values.shape[0], -1)
         return (self.incidence @ flat).reshape((self.n,) + values.shape[1:])
+
+
+def mesh_area(V, F):
+    """Total surface area of a triangle mesh (zero-area faces count 0)."""
+    return float(np.nansum(igl.doublearea(V, F)) / 2.0)
 
 
 def cell_graph(V, F, weights="cotan-clamped"):
@@ -77,6 +85,8 @@ def cell_graph(V, F, weights="cotan-clamped"):
     rows = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
     cols = np.concatenate([F[:, 2], F[:, 0], F[:, 1]])
     vals = half_cot.T.ravel()
+    finite = np.isfinite(vals)
+    vals = np.where(finite, vals, 0.0)
     W = sp.coo_matrix((np.concatenate([vals, vals]),
                        (np.concatenate([rows, cols]), np.concatenate([cols, rows]))),
                       shape=(n, n)).tocsr()
@@ -88,7 +98,8 @@ def cell_graph(V, F, weights="cotan-clamped"):
         W.data = np.ones_like(W.data)
     I = np.repeat(np.arange(n), np.diff(W.indptr))
     K = (sp.diags(np.asarray(W.sum(axis=1)).ravel()) - W).tocsr()
-    area = float(igl.doublearea(V, F).sum() / 2.0)
+    area = mesh_area(V, F)
     incidence = sp.csr_matrix((np.ones(I.size), (I, np.arange(I.size))), shape=(n, I.size))
     return CellGraph(I=I, J=W.indices.astype(np.int64), c=W.data.copy(),
-                     degree=np.diff(W.indptr), laplacian=K, area=area, incidence=incidence)
+                     degree=np.diff(W.indptr), laplacian=K, area=area, incidence=incidence,
+                     degenerate=int((~finite).sum()))

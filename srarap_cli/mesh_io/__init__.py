@@ -5,13 +5,13 @@ read with meshio. Writers are deterministic (no timestamps) and atomic (temporar
 the target folder, then rename), so a failed run never leaves a partial file behind.
 """
 import os
-import tempfile
 import warnings
 
 import meshio
 import numpy as np
 
 from ..errors import InputError, OutputError
+from .commit import commit_files
 from .mesh import Mesh
 from .normals import recompute_normals
 from .obj import format_obj, read_obj
@@ -122,21 +122,4 @@ def write_mesh(path, mesh):
 
 def atomic_write(path, data):
     """Write bytes to ``path`` via a temporary file in the same folder and a rename."""
-    folder = os.path.dirname(os.path.abspath(path))
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=".srarap-", suffix=".tmp", dir=folder)
-    except OSError as exc:
-        raise OutputError(f"{path}: cannot write: {exc.strerror}") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException as exc:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise OutputError(f"{path}: cannot write: {exc.strerror}") from None
-        raise
+    commit_files([(path, data)])

@@ -1,0 +1,14 @@
+"""The ``srarap`` command group; each subcommand lives in its own module."""
+import click
+
+from .deform import deform
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.option("--debug", is_flag=True, help="Show tracebacks of failures.")
+@click.version_option(package_name="srarap-cli", prog_name="srarap")
+def main(debug):
+    """Deform triangle meshes as rigidly as possible with smooth rotations (SR-ARAP)."""
+
+
+main.add_command(deform)

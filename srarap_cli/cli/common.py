@@ -1,0 +1,65 @@
+"""What every subcommand shares: error-to-exit-code mapping and output preflight."""
+import functools
+import os
+import sys
+import traceback
+
+import click
+
+from .. import exit_codes
+from ..deformer import NumericalError
+from ..errors import InputError, OutputError
+from ..global_step import SingularSystemError
+
+
+def fail(code, message):
+    click.echo(f"srarap: error: {message}", err=True)
+    sys.exit(code)
+
+
+def guarded(func):
+    """Turn known failures into one stderr line and a documented exit code."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        debug = click.get_current_context().find_root().params.get("debug", False)
+        try:
+            return func(*args, **kwargs)
+        except (click.exceptions.Exit, click.ClickException, SystemExit):
+            raise
+        except Exception as exc:  # mapped below; the traceback is shown with --debug only
+            if debug:
+                traceback.print_exc()
+            code, text = _classify(exc)
+            fail(code, text)
+        except KeyboardInterrupt:
+            fail(exit_codes.INTERRUPTED, "interrupted; no output written")
+
+    return wrapper
+
+
+def _classify(exc):
+    if isinstance(exc, InputError):
+        return exit_codes.INVALID_INPUT, str(exc)
+    if isinstance(exc, OutputError):
+        return exit_codes.OUTPUT_ERROR, str(exc)
+    if isinstance(exc, NumericalError):
+        return exit_codes.NUMERICAL_FAILURE, f"{exc}; no output written"
+    if isinstance(exc, SingularSystemError):
+        return exit_codes.NUMERICAL_FAILURE, f"singular system ({exc}); no output written"
+    return exit_codes.INTERNAL_ERROR, (f"internal error: {type(exc).__name__}: {exc} "
+                                       "(rerun with --debug for the traceback and report it)")
+
+
+def check_output_path(path, allowed, what):
+    """Fail before any work when an output could not be written."""
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in allowed:
+        raise click.UsageError(f"{what} {path!r}: extension must be one of {', '.join(allowed)}")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise OutputError(f"{path}: folder {folder} does not exist")
+    if not os.access(folder, os.W_OK):
+        raise OutputError(f"{path}: folder {folder} is not writable")
+    if os.path.isdir(path):
+        raise OutputError(f"{path}: is a folder")

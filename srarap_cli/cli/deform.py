@@ -1,0 +1,71 @@
+"""``srarap deform``: mesh + handle file -> deformed mesh + energy log."""
+import os
+
+import click
+
+from .. import exit_codes
+from ..handles import load_handles
+from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
+from ..mesh_io.commit import commit_files
+from ..operators import WEIGHT_KINDS
+from ..pipeline import deform_mesh, settings
+from ..solve_log import LOG_FORMATS, format_log
+from .common import check_output_path, guarded
+
+
+@click.command("deform")
+@click.argument("mesh", type=click.Path(dir_okay=False))
+@click.argument("handles", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", "out", required=True, type=click.Path(dir_okay=False),
+              help="Deformed mesh to write: .obj, .ply or .off.")
+@click.option("--log", "log", type=click.Path(dir_okay=False),
+              help="Per-iteration energy log: .csv or .jsonl.")
+@click.option("--alpha", type=click.FloatRange(min=0, min_open=True),
+              help="Bending weight (energy uses alpha * total area). [default: 0.14]")
+@click.option("--feedback", type=click.FloatRange(min=0),
+              help="Pull of each rotor toward its previous value (paper's eps). [default: 0.2]")
+@click.option("--max-iter", type=click.IntRange(min=0),
+              help="Local/global iterations at most. [default: 1000]")
+@click.option("--tol", type=click.FloatRange(min=0),
+              help="Stop when the relative energy change is at most this. [default: 1e-6]")
+@click.option("--weights", type=click.Choice(WEIGHT_KINDS),
+              help="Edge weights. [default: cotan-clamped]")
+@click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
+@guarded
+def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, quiet):
+    """Deform MESH as rigidly as possible with smooth rotations.
+
+    HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
+    Exit codes: 0 converged, 3 not converged within --max-iter (output still written),
+    2 usage, 4 invalid input, 5 numerical failure, 6 output error.
+    """
+    check_output_path(out, WRITE_FORMATS, "output")
+    if log is not None:
+        check_output_path(log, LOG_FORMATS, "log")
+        if os.path.abspath(log) == os.path.abspath(out):
+            raise click.UsageError("--log and --output name the same file")
+    source = read_mesh(mesh)
+    constraints = load_handles(handles, source.vertices)
+    overrides = dict(alpha=alpha, feedback=feedback, max_iter=max_iter, tol=tol, weights=weights)
+    deformed, result, notes = deform_mesh(source, constraints, **overrides)
+    mesh_bytes, lost = format_mesh(deformed, os.path.splitext(out)[1].lower())
+    files = [(out, mesh_bytes)]
+    if log is not None:
+        files.append((log, format_log(result.log, os.path.splitext(log)[1].lower()).encode()))
+    commit_files(files)
+    if not quiet:
+        for note in notes + lost:
+            click.echo(f"srarap: warning: {note}", err=True)
+        click.echo(_summary(result, settings(constraints.solver, overrides), out), err=True)
+    if not result.converged:
+        raise SystemExit(exit_codes.NOT_CONVERGED)
+
+
+def _summary(result, opts, out):
+    last = result.log[-1]
+    state = (f"converged in {result.iterations} iterations" if result.converged else
+             f"NOT converged after {result.iterations} iterations "
+             f"(relative change {last['rel_change']:.3g} > tol {opts['tol']:g})")
+    return (f"srarap deform: {state}; energy {last['total']:.6g} (membrane "
+            f"{last['membrane']:.6g}, bending {last['bending']:.6g}); {last['seconds']:.2f} s; "
+            f"wrote {out}")

@@ -1,0 +1,9 @@
+"""Exit codes of the ``srarap`` command (documented in the README)."""
+OK = 0
+INTERNAL_ERROR = 1
+USAGE = 2  # click's own code for bad options
+NOT_CONVERGED = 3
+INVALID_INPUT = 4
+NUMERICAL_FAILURE = 5
+OUTPUT_ERROR = 6
+INTERRUPTED = 130

@@ -1,0 +1,156 @@
+"""The handle file: which vertices are constrained and where they go.
+
+YAML or JSON (same schema), or a Botsch-Sorkine ``.sel`` file with its ``.def`` beside it.
+The schema is documented in the README; :func:`load_handles` validates it and reports each
+problem as one line naming the file, group and field.
+"""
+import json
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+import yaml
+
+from ..errors import InputError
+from ..operators import WEIGHT_KINDS
+from .fields import Context
+from .formats import read_def, read_sel
+from .selectors import SELECTOR_KEYS, select
+from .transforms import ACTION_KEYS, targets
+
+SOLVER_KEYS = ("alpha", "feedback", "max_iter", "tol", "weights")
+TOP_KEYS = ("groups", "region", "solver")
+
+
+@dataclass
+class Constraints:
+    """Constrained vertices and their targets, resolved against a mesh.
+
+    Attributes
+    ----------
+    ids : (k,) int array, sorted constrained vertex ids
+    targets : (k, 3) float array, target position of each id
+    groups : dict of group name -> (j,) int array of its vertex ids
+    region : (r,) int array or None, vertices allowed to move (region of interest);
+        everything else stays at rest
+    solver : dict, solver settings given in the file (keys from SOLVER_KEYS)
+    """
+
+    ids: np.ndarray
+    targets: np.ndarray
+    groups: dict = field(default_factory=dict)
+    region: np.ndarray = None
+    solver: dict = field(default_factory=dict)
+
+
+def load_handles(path, V):
+    """Read and validate a handle file against rest positions ``V`` (n, 3).
+
+    Parameters
+    ----------
+    path : str, ``.yaml``/``.yml``, ``.json`` or ``.sel``
+    V : (n, 3) float array
+
+    Returns
+    -------
+    Constraints
+    """
+    path = str(path)
+    if path.lower().endswith(".sel"):
+        return _from_sel(path, V)
+    return parse_handles(_load_document(path), V, path, os.path.dirname(os.path.abspath(path)))
+
+
+def _load_document(path):
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in (".yaml", ".yml", ".json"):
+        raise InputError(f"{path}: handle file must be .yaml, .yml, .json or .sel")
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return json.load(fh) if ext == ".json" else yaml.safe_load(fh)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
+    except (ValueError, yaml.YAMLError) as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        mark = getattr(exc, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        raise InputError(f"{path}: not valid {ext[1:].upper()}{where}: {first}") from None
+
+
+def parse_handles(doc, V, path="<handles>", base="."):
+    """Validate an already-loaded handle document (dict) against ``V``; see :func:`load_handles`."""
+    ctx = Context(path)
+    doc = ctx.mapping(doc, "the handle file", TOP_KEYS)
+    groups = doc.get("groups")
+    if not isinstance(groups, dict) or not groups:
+        raise ctx.error("'groups' must map at least one group name to its selection and action")
+    names, ids, tgts = [], [], []
+    for name, spec in groups.items():
+        gctx = ctx.at(f"group {name!r}")
+        spec = gctx.mapping(spec, "the group", SELECTOR_KEYS + ACTION_KEYS)
+        sel = select(gctx, spec, V, base)
+        names.append(str(name))
+        ids.append(sel)
+        tgts.append(targets(gctx, spec, V[sel], base))
+    region = None
+    if "region" in doc:
+        rctx = ctx.at("region")
+        region = select(rctx, rctx.mapping(doc["region"], "region", SELECTOR_KEYS), V, base)
+    merged_ids, merged = _merge(ctx, names, ids, tgts, V)
+    return Constraints(ids=merged_ids, targets=merged, groups=dict(zip(names, ids)),
+                       region=region, solver=_solver(ctx.at("solver"), doc.get("solver", {})))
+
+
+def _merge(ctx, names, ids, tgts, V):
+    """One target per vertex; a vertex two groups send to different places is an error."""
+    all_ids = np.concatenate(ids)
+    all_t = np.concatenate(tgts)
+    owner = np.repeat(np.arange(len(names)), [len(i) for i in ids])
+    order = np.argsort(all_ids, kind="stable")
+    all_ids, all_t, owner = all_ids[order], all_t[order], owner[order]
+    first = np.concatenate([[True], all_ids[1:] != all_ids[:-1]])
+    lead = np.maximum.accumulate(np.where(first, np.arange(all_ids.size), 0))
+    scale = max(float(np.ptp(V, axis=0).max()), 1e-300)
+    clash = np.flatnonzero(np.linalg.norm(all_t - all_t[lead], axis=1) > 1e-9 * scale)
+    if clash.size:
+        k = clash[0]
+        raise ctx.error(f"vertex {all_ids[k]} is in groups {names[owner[lead[k]]]!r} and "
+                        f"{names[owner[k]]!r} with different targets")
+    return all_ids[first], all_t[first]
+
+
+def _solver(ctx, spec):
+    spec = ctx.mapping(spec, "solver", SOLVER_KEYS)
+    out = {}
+    if "alpha" in spec:
+        out["alpha"] = ctx.number(spec["alpha"], "alpha", 0, strict=True)
+    if "feedback" in spec:
+        out["feedback"] = ctx.number(spec["feedback"], "feedback", 0)
+    if "max_iter" in spec:
+        out["max_iter"] = ctx.integer(spec["max_iter"], "max_iter", 0)
+    if "tol" in spec:
+        out["tol"] = ctx.number(spec["tol"], "tol", 0)
+    if "weights" in spec:
+        if spec["weights"] not in WEIGHT_KINDS:
+            raise ctx.error(f"weights must be one of {', '.join(WEIGHT_KINDS)}")
+        out["weights"] = spec["weights"]
+    return out
+
+
+def _from_sel(path, V):
+    """A ``.sel`` file alone: status 0 stays fixed, status 2 follows the ``.def`` beside it."""
+    status = read_sel(path)
+    if status.size != len(V):
+        raise InputError(f"{path}: has {status.size} entries but the mesh has {len(V)} vertices")
+    def_path = os.path.splitext(path)[0] + ".def"
+    fixed, handle = np.flatnonzero(status == 0), np.flatnonzero(status == 2)
+    if fixed.size + handle.size == 0:
+        raise InputError(f"{path}: no vertex has status 0 (fixed) or 2 (handle)")
+    t = V.copy()
+    if handle.size:
+        if not os.path.isfile(def_path):
+            raise InputError(f"{def_path}: no such file (the .def that goes with {path})")
+        M = read_def(def_path)
+        t[handle] = V[handle] @ M[:3, :3].T + M[:3, 3]
+    ids = np.flatnonzero(status != 1)
+    return Constraints(ids=ids, targets=t[ids], groups={"fixed": fixed, "handle": handle})

@@ -1,0 +1,96 @@
+"""Selectors: which vertices a handle group (or the region of interest) covers."""
+import os
+
+import numpy as np
+
+from .formats import SEL_STATUS, read_dmat, read_sel
+
+SELECTOR_KEYS = ("indices", "sphere", "box", "dmat", "sel")
+
+
+def _file(ctx, base, value, name):
+    if not isinstance(value, str) or not value:
+        raise ctx.error(f"{name} must be a file path")
+    return os.path.join(base, value)
+
+
+def _indices(ctx, spec, V, base):
+    if isinstance(spec, (str, bool)) or not isinstance(spec, (list, tuple)):
+        raise ctx.error("indices must be a list of vertex indices")
+    idx = np.array([ctx.integer(i, "indices") for i in spec], dtype=np.int64)
+    bad = idx[(idx < 0) | (idx >= len(V))]
+    if bad.size:
+        raise ctx.error(f"indices: vertex {bad[0]} out of range (mesh has {len(V)} vertices)")
+    return idx
+
+
+def _sphere(ctx, spec, V, base):
+    spec = ctx.mapping(spec, "sphere", ("center", "radius"))
+    if "center" not in spec or "radius" not in spec:
+        raise ctx.error("sphere needs 'center' and 'radius'")
+    center = ctx.vector(spec["center"], "center", 3)
+    radius = ctx.number(spec["radius"], "radius", 0, strict=True)
+    return np.flatnonzero(np.sum((V - center) ** 2, axis=1) <= radius * radius)
+
+
+def _box(ctx, spec, V, base):
+    spec = ctx.mapping(spec, "box", ("min", "max"))
+    if "min" not in spec or "max" not in spec:
+        raise ctx.error("box needs 'min' and 'max'")
+    lo, hi = ctx.vector(spec["min"], "min", 3), ctx.vector(spec["max"], "max", 3)
+    if (lo > hi).any():
+        raise ctx.error("box: min must not exceed max in any coordinate")
+    return np.flatnonzero(np.all((V >= lo) & (V <= hi), axis=1))
+
+
+def _checked_length(ctx, values, V, path):
+    if values.size != len(V):
+        raise ctx.error(f"{path} has {values.size} entries but the mesh has {len(V)} vertices")
+    return values
+
+
+def _dmat(ctx, spec, V, base):
+    spec = ctx.mapping(spec, "dmat", ("file", "group"))
+    if "file" not in spec or "group" not in spec:
+        raise ctx.error("dmat needs 'file' and 'group'")
+    path = _file(ctx, base, spec["file"], "dmat file")
+    group = ctx.integer(spec["group"], "dmat group", 0)
+    return np.flatnonzero(_checked_length(ctx, read_dmat(path), V, path) == group)
+
+
+def _sel(ctx, spec, V, base):
+    spec = ctx.mapping(spec, "sel", ("file", "status"))
+    if "file" not in spec or "status" not in spec:
+        raise ctx.error("sel needs 'file' and 'status' (fixed, free or handle)")
+    if spec["status"] not in SEL_STATUS:
+        raise ctx.error("sel status must be one of fixed, free, handle")
+    path = _file(ctx, base, spec["file"], "sel file")
+    return np.flatnonzero(_checked_length(ctx, read_sel(path), V, path)
+                          == SEL_STATUS[spec["status"]])
+
+
+_SELECTORS = {"indices": _indices, "sphere": _sphere, "box": _box, "dmat": _dmat, "sel": _sel}
+
+
+def select(ctx, spec, V, base):
+    """Union of the vertices picked by every selector key present in ``spec``.
+
+    Parameters
+    ----------
+    ctx : fields.Context
+    spec : dict, a group or region entry of the handle file
+    V : (n, 3) float array, rest positions
+    base : str, folder that relative file paths start from
+
+    Returns
+    -------
+    (k,) int array of sorted vertex ids
+    """
+    keys = [k for k in SELECTOR_KEYS if k in spec]
+    if not keys:
+        raise ctx.error(f"no selector (use one or more of {', '.join(SELECTOR_KEYS)})")
+    picked = [_SELECTORS[k](ctx, spec[k], V, base) for k in keys]
+    ids = np.unique(np.concatenate(picked))
+    if ids.size == 0:
+        raise ctx.error(f"selects no vertex ({', '.join(keys)})")
+    return ids
