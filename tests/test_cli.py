@@ -1,0 +1,163 @@
+"""``srarap deform`` end to end: outputs, logs, determinism and exit codes."""
+import csv
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import yaml
+from click.testing import CliRunner
+
+from srarap_cli.cli import main
+from srarap_cli.mesh_io import read_mesh, write_mesh
+
+from helpers import ROOT, tube_mesh
+
+BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
+TWIST = os.path.join(ROOT, "configs", "bar-twist.yaml")
+
+
+def run(*args):
+    return CliRunner().invoke(main, ["deform", *map(str, args)])
+
+
+@pytest.fixture()
+def small(tmp_path):
+    """A small quad tube with UVs and a handle file bending it."""
+    mesh_path = tmp_path / "tube.obj"
+    write_mesh(str(mesh_path), tube_mesh(rings=6, segments=6))
+    handles = {"groups": {
+        "base": {"box": {"min": [-2, -2, -0.01], "max": [2, 2, 0.01]}, "fixed": True},
+        "tip": {"box": {"min": [-2, -2, 5.99], "max": [2, 2, 6.01]},
+                "rotate": {"axis": [0, 1, 0], "angle": 40}, "translate": [1, 0, 0]}}}
+    handle_path = tmp_path / "h.yaml"
+    handle_path.write_text(yaml.safe_dump(handles))
+    return mesh_path, handle_path
+
+
+def test_sample_case_converges_and_keeps_uvs_and_polygons(tmp_path):
+    out, log = tmp_path / "bar.obj", tmp_path / "bar.csv"
+    r = run(BAR, TWIST, "-o", out, "--log", log)
+    assert r.exit_code == 0, r.output
+    src, res = read_mesh(BAR), read_mesh(str(out))
+    assert np.array_equal(res.face_sizes, src.face_sizes)
+    assert np.array_equal(res.face_vertices, src.face_vertices)
+    assert np.array_equal(res.uv, src.uv) and np.array_equal(res.face_uv, src.face_uv)
+    base = src.vertices[:, 2] < 1e-9
+    assert np.array_equal(res.vertices[base], src.vertices[base])
+    top = src.vertices[:, 2] > 10 - 1e-9
+    x, y = src.vertices[top][:, 0], src.vertices[top][:, 1]  # 90 degrees about z: (-y, x)
+    assert np.allclose(res.vertices[top][:, :2], np.column_stack([-y, x]), atol=1e-12)
+    rows = list(csv.DictReader(open(log)))
+    assert list(rows[0]) == ["iteration", "membrane", "bending", "total", "rel_change",
+                             "max_move", "seconds"]
+    assert float(rows[-1]["rel_change"]) <= 1e-6 and "converged" in r.stderr
+
+
+def test_same_inputs_give_byte_identical_output(small, tmp_path):
+    mesh, handles = small
+    outs = [tmp_path / "a.ply", tmp_path / "b.ply"]
+    for out in outs:
+        assert run(mesh, handles, "-o", out, "--max-iter", 30, "-q").exit_code in (0, 3)
+    assert outs[0].read_bytes() == outs[1].read_bytes()
+
+
+@pytest.mark.parametrize("suffix", [".obj", ".ply", ".off"])
+def test_every_output_format_keeps_vertex_order(small, tmp_path, suffix):
+    mesh, handles = small
+    out = tmp_path / f"out{suffix}"
+    r = run(mesh, handles, "-o", out, "--max-iter", 5, "-q")
+    assert r.exit_code == 3 and r.stderr == ""  # 5 iterations do not converge; quiet
+    a, b = read_mesh(str(mesh)), read_mesh(str(out))
+    assert len(b.vertices) == len(a.vertices)
+    assert np.array_equal(b.face_vertices, a.face_vertices)
+    assert np.array_equal(b.vertices[:6], a.vertices[:6])  # base ring, fixed
+
+
+def test_jsonl_log_and_option_override(small, tmp_path):
+    mesh, handles = small
+    log = tmp_path / "log.jsonl"
+    r = run(mesh, handles, "-o", tmp_path / "o.obj", "--log", log, "--max-iter", 4)
+    rows = [json.loads(line) for line in log.read_text().splitlines()]
+    assert [row["iteration"] for row in rows] == [0, 1, 2, 3, 4]
+    assert rows[0]["rel_change"] is None
+    assert all(row["total"] == row["membrane"] + row["bending"] for row in rows)
+    assert r.exit_code == 3 and "NOT converged after 4 iterations" in r.stderr
+
+
+def test_solver_settings_in_file_apply_unless_overridden(small, tmp_path):
+    mesh, handles = small
+    doc = yaml.safe_load(handles.read_text())
+    doc["solver"] = {"max_iter": 2}
+    handles.write_text(yaml.safe_dump(doc))
+    log = tmp_path / "l.csv"
+    run(mesh, handles, "-o", tmp_path / "o.obj", "--log", log)
+    assert len(log.read_text().splitlines()) == 1 + 3
+    run(mesh, handles, "-o", tmp_path / "o.obj", "--log", log, "--max-iter", 1)
+    assert len(log.read_text().splitlines()) == 1 + 2
+
+
+def test_region_of_interest_leaves_the_rest_untouched(small, tmp_path):
+    mesh, handles = small
+    doc = yaml.safe_load(handles.read_text())
+    doc["region"] = {"box": {"min": [-2, -2, 3.9], "max": [2, 2, 7]}}
+    handles.write_text(yaml.safe_dump(doc))
+    out = tmp_path / "o.obj"
+    assert run(mesh, handles, "-o", out, "-q").exit_code == 0
+    a, b = read_mesh(str(mesh)).vertices, read_mesh(str(out)).vertices
+    outside = a[:, 2] < 3.9
+    assert np.array_equal(a[outside], b[outside])
+    assert np.abs(a[~outside] - b[~outside]).max() > 0.5
+
+
+def test_missing_mesh_is_invalid_input_without_traceback(small, tmp_path):
+    _, handles = small
+    out = tmp_path / "o.obj"
+    r = run(tmp_path / "nope.obj", handles, "-o", out)
+    assert r.exit_code == 4 and "nope.obj" in r.stderr and "Traceback" not in r.output
+    assert not out.exists()
+
+
+def test_malformed_handle_file_is_invalid_input_and_writes_nothing(small, tmp_path):
+    mesh, _ = small
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("groups:\n  tip:\n    sphere: {center: [0, 0, 0], radius: -1}\n    fixed: true\n")
+    out = tmp_path / "o.obj"
+    r = run(mesh, bad, "-o", out)
+    assert r.exit_code == 4
+    assert r.stderr.strip() == f"srarap: error: {bad}: group 'tip': radius must be > 0"
+    assert not out.exists()
+
+
+def test_usage_and_output_errors(small, tmp_path):
+    mesh, handles = small
+    assert run(mesh, handles, "-o", tmp_path / "o.stl").exit_code == 2
+    assert run(mesh, handles, "-o", tmp_path / "o.obj", "--alpha", "0").exit_code == 2
+    r = run(mesh, handles, "-o", tmp_path / "no" / "such" / "dir.obj")
+    assert r.exit_code == 6 and "does not exist" in r.stderr
+
+
+def test_existing_output_survives_a_failed_run(small, tmp_path):
+    _, handles = small
+    out = tmp_path / "o.obj"
+    out.write_text("precious")
+    bad_mesh = tmp_path / "bad.off"
+    bad_mesh.write_text("OFF\n3 1 0\n0 0 0\n")
+    assert run(bad_mesh, handles, "-o", out).exit_code == 4
+    assert out.read_text() == "precious"
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".srarap-")] == []
+
+
+def test_module_entry_point_and_console_script(small, tmp_path):
+    mesh, handles = small
+    out = tmp_path / "o.off"
+    cmd = [sys.executable, "-m", "srarap_cli", "deform", str(mesh), str(handles), "-o", str(out)]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    assert p.returncode == 0 and "converged" in p.stderr and out.exists()
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", str(mesh),
+                        str(tmp_path / "missing.yaml"), "-o", str(out)],
+                       capture_output=True, text=True)
+    assert p.returncode == 4 and "Traceback" not in p.stderr
+    assert p.stderr.count("\n") == 1

@@ -1,0 +1,123 @@
+"""Reading and writing meshes: order, polygons, UVs, normals, determinism."""
+import glob
+import os
+
+import meshio
+import numpy as np
+import pytest
+
+from srarap_cli.errors import InputError
+from srarap_cli.mesh_io import format_mesh, read_mesh, write_mesh
+from srarap_cli.mesh_io.normals import recompute_normals
+from srarap_cli.quaternion import from_axis_angle, to_matrix
+
+from helpers import ROOT, SHARED, tube_mesh
+
+
+def same_structure(a, b):
+    assert np.array_equal(a.face_sizes, b.face_sizes)
+    assert np.array_equal(a.face_vertices, b.face_vertices)
+
+
+@pytest.mark.parametrize("suffix", [".obj", ".off", ".ply"])
+def test_round_trip_keeps_vertices_and_polygons_exactly(tmp_path, suffix):
+    mesh = tube_mesh(rings=3, segments=5)
+    mesh.vertices = mesh.vertices + np.random.default_rng(0).normal(size=mesh.vertices.shape)
+    path = str(tmp_path / f"m{suffix}")
+    write_mesh(path, mesh)
+    back = read_mesh(path)
+    assert np.array_equal(back.vertices, mesh.vertices)  # 17 significant digits / binary
+    same_structure(back, mesh)
+
+
+def test_obj_keeps_uv_seams_normals_and_other_statements(tmp_path):
+    src = tmp_path / "in.obj"
+    src.write_text("mtllib a.mtl\no thing\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                   "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0.5\nvn 0 0 1\n"
+                   "usemtl red\nf 1/1/1 2/2/1 3/3/1\nusemtl blue\nf -4/5/1 -2/4/1 -1/4/1\n"
+                   "f 1 3 4\n")
+    mesh = read_mesh(str(src))
+    assert mesh.uv.shape == (5, 2) and mesh.normals.shape == (1, 3)
+    assert mesh.face_vertices.tolist() == [0, 1, 2, 0, 2, 3, 0, 2, 3]
+    assert mesh.face_uv.tolist() == [0, 1, 2, 4, 3, 3, -1, -1, -1]
+    text = format_mesh(mesh, ".obj")[0].decode()
+    assert text.index("usemtl red") < text.index("f 1/1/1") < text.index("usemtl blue")
+    assert "f 1/5/1 3/4/1 4/4/1" in text and "f 1 3 4" in text and "mtllib a.mtl" in text
+    out = tmp_path / "out.obj"
+    write_mesh(str(out), mesh)
+    again = read_mesh(str(out))
+    assert np.array_equal(again.face_uv, mesh.face_uv) and np.array_equal(again.uv, mesh.uv)
+
+
+def test_off_reader_takes_headers_meshio_rejects(tmp_path):
+    path = tmp_path / "a.off"
+    path.write_text("OFF\n# comment\n4  2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3 255 0 0\n")
+    with pytest.raises(Exception):
+        meshio.read(str(path))
+    mesh = read_mesh(str(path))
+    assert mesh.vertices.shape == (4, 3) and mesh.face_vertices.tolist() == [0, 1, 2, 0, 2, 3]
+
+
+def test_ply_output_is_valid_for_meshio_and_carries_per_vertex_uv(tmp_path):
+    mesh = tube_mesh(rings=2, segments=4)
+    mesh.face_uv = mesh.face_vertices.copy()
+    mesh.uv = mesh.vertices[:, :2] * 0.5
+    path = str(tmp_path / "m.ply")
+    assert write_mesh(path, mesh) == []
+    m = meshio.read(path)
+    assert np.array_equal(m.points, mesh.vertices)
+    assert np.array_equal(np.concatenate([c.data.ravel() for c in m.cells]), mesh.face_vertices)
+    assert np.array_equal(m.point_data["s"], mesh.uv[:, 0])
+
+
+def test_formats_without_per_corner_uvs_say_what_they_drop(tmp_path):
+    mesh = tube_mesh(rings=2, segments=4)  # UV seam: several uvs per vertex
+    assert "texture coordinates not written" in write_mesh(str(tmp_path / "m.off"), mesh)[0]
+
+
+def test_normals_follow_the_deformation():
+    mesh = read_mesh(os.path.join(ROOT, "sample_meshes", "spot.obj"))
+    R = to_matrix(from_axis_angle([1, 2, 3], 77))
+    moved = mesh.with_vertices(mesh.vertices @ R.T)
+    assert np.abs(moved.normals - recompute_normals(mesh) @ R.T).max() < 1e-12
+    assert np.allclose(np.linalg.norm(moved.normals, axis=1), 1)
+
+
+def test_output_bytes_are_deterministic(tmp_path):
+    mesh = read_mesh(os.path.join(ROOT, "sample_meshes", "spot.obj"))
+    for suffix in (".obj", ".off", ".ply"):
+        assert format_mesh(mesh, suffix)[0] == format_mesh(read_mesh(
+            os.path.join(ROOT, "sample_meshes", "spot.obj")), suffix)[0]
+
+
+def test_every_shared_mesh_reads_with_its_vertex_count():
+    assert os.path.isdir(SHARED), "the tests expect ../shared/meshes beside the repository"
+    counts = {"cylinder.off": 4802, "decimated-max.obj": 5272, "spot.obj": 11533,
+              "torus.obj": 2304, "hand_lowres.obj": 810, "armadillo1.obj": 502}
+    found = {os.path.basename(p): p for p in glob.glob(os.path.join(SHARED, "*.o[bf][jf]"))}
+    assert set(counts) <= set(found)
+    for name, n in counts.items():
+        assert len(read_mesh(found[name]).vertices) == n
+
+
+@pytest.mark.parametrize("text, message", [
+    ("", "no vertices"),
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "references vertex 3"),
+    ("v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n", "vertex 1 has a NaN"),
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", "index 0"),
+    ("v 0 0\nf 1 2 3\n", "malformed 'v'"),
+])
+def test_bad_obj_files_are_invalid_input(tmp_path, text, message):
+    path = tmp_path / "bad.obj"
+    path.write_text(text)
+    with pytest.raises(InputError, match=message):
+        read_mesh(str(path))
+
+
+def test_truncated_off_and_unknown_format_are_invalid_input(tmp_path):
+    path = tmp_path / "t.off"
+    path.write_text("OFF\n4 2 0\n0 0 0\n1 0 0\n")
+    with pytest.raises(InputError, match="ends early"):
+        read_mesh(str(path))
+    with pytest.raises(InputError, match="unsupported mesh format"):
+        read_mesh(str(tmp_path / "x.vtk"))
