@@ -13,7 +13,7 @@ LENGTH, RADIUS, RINGS, SEGMENTS = 10.0, 1.0, 40, 16
 
 def bar(length=LENGTH, radius=RADIUS, rings=RINGS, segments=SEGMENTS):
     """Vertices (n, 3), faces (list of tuples), uv (t, 2) and per-face uv index tuples."""
-    LENGTH, RINGS, SEGMENTS = length, rings, segments  # noqa: N806 (same names as the defaults)
+    LENGTH, RINGS, SEGMENTS = length, rings, segments
     theta = 2 * np.pi * np.arange(SEGMENTS) / SEGMENTS
     z = np.linspace(0.0, LENGTH, RINGS + 1)
     ring = np.column_stack([radius * np.cos(theta), radius * np.sin(theta)])
@@ -22,8 +22,8 @@ def bar(length=LENGTH, radius=RADIUS, rings=RINGS, segments=SEGMENTS):
     bottom, top = len(V) - 2, len(V) - 1
     uv = np.array([[s / SEGMENTS, h / LENGTH] for h in z for s in range(SEGMENTS + 1)]
                   + [[0.5, 0.0], [0.5, 1.0]])
-    vid = lambda r, s: r * SEGMENTS + s % SEGMENTS  # noqa: E731
-    tid = lambda r, s: r * (SEGMENTS + 1) + s  # noqa: E731
+    vid = lambda r, s: r * SEGMENTS + s % SEGMENTS
+    tid = lambda r, s: r * (SEGMENTS + 1) + s
     faces, tfaces = [], []
     for r in range(RINGS):
         for s in range(SEGMENTS):

@@ -3,7 +3,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse.csgraph as csgraph
+from scipy.sparse import csgraph
 
 from .energy import bending_energy, membrane_energy
 from .global_step import PoissonSolver
@@ -184,8 +184,8 @@ class Deformer:
             previous = result.log[-1]["total"]
             rel = abs(total - previous) / max(previous, self._energy_floor)
             move = float(np.sqrt(np.max(np.sum((P - P_prev) ** 2, axis=1), initial=0.0)))
-        row = dict(iteration=len(result.log), membrane=membrane, bending=bending, total=total,
-                   rel_change=rel, max_move=move, seconds=time.perf_counter() - start)
+        row = {"iteration": len(result.log), "membrane": membrane, "bending": bending, "total": total,
+                   "rel_change": rel, "max_move": move, "seconds": time.perf_counter() - start}
         result.log.append(row)
         if callback is not None:
             callback(row)

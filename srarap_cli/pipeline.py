@@ -6,7 +6,7 @@ from .operators import mesh_area
 from .quaternion import IDENTITY
 from .region import restrict
 
-DEFAULTS = dict(alpha=0.14, feedback=0.2, max_iter=1000, tol=1e-6, weights="cotan-clamped")
+DEFAULTS = {"alpha": 0.14, "feedback": 0.2, "max_iter": 1000, "tol": 1e-6, "weights": "cotan-clamped"}
 
 
 def settings(file_settings, overrides):

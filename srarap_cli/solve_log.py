@@ -1,6 +1,7 @@
 """The per-iteration energy log, as CSV or JSON Lines (chosen by the file extension)."""
 import io
 import json
+import math
 import os
 
 from .deformer import LOG_FIELDS
@@ -24,12 +25,12 @@ def format_log(rows, suffix):
 
 def _cell(value):
     if isinstance(value, float):
-        return "" if value != value else repr(value)
+        return "" if math.isnan(value) else repr(value)
     return str(value)
 
 
 def _json(value):
-    return None if isinstance(value, float) and value != value else value
+    return None if isinstance(value, float) and math.isnan(value) else value
 
 
 def write_log(path, rows):

@@ -3,14 +3,12 @@ import igl
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from helpers import ends, random_rotation, symmetric_tube, tube
 from scipy.spatial.transform import Rotation
 
 from srarap_cli.deformer import Deformer, deform
-from srarap_cli.local_step.linear import LinearRotorStep
 from srarap_cli.local_step.membrane import cell_covariance
 from srarap_cli.quaternion import IDENTITY, from_axis_angle, multiply, to_matrix
-
-from helpers import ends, random_rotation, symmetric_tube, tube
 
 ALPHA = 0.14
 

@@ -4,12 +4,11 @@ import json
 import numpy as np
 import pytest
 import yaml
+from helpers import tube
 
 from srarap_cli.errors import InputError
 from srarap_cli.handles import load_handles
 from srarap_cli.quaternion import from_axis_angle, to_matrix
-
-from helpers import tube
 
 V, F = tube()
 BOTTOM = np.flatnonzero(V[:, 2] < 1e-9)

@@ -1,11 +1,10 @@
 """M_i against a brute-force quaternion evaluation of the membrane residual."""
 import numpy as np
+from helpers import tube
 
 from srarap_cli.local_step.membrane import cell_covariance, membrane_matrices
 from srarap_cli.operators import cell_graph
 from srarap_cli.quaternion import multiply
-
-from helpers import tube
 
 
 def pure(v):

@@ -1,7 +1,13 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from srarap_cli.quaternion import from_axis_angle, multiply, normalize, rotate, to_matrix
+from srarap_cli.quaternion import (
+    from_axis_angle,
+    multiply,
+    normalize,
+    rotate,
+    to_matrix,
+)
 
 
 def test_rotate_and_matrix_agree_with_scipy():

@@ -27,7 +27,9 @@ def guarded(func):
             return func(*args, **kwargs)
         except (click.exceptions.Exit, click.ClickException, SystemExit):
             raise
-        except Exception as exc:  # mapped below; the traceback is shown with --debug only
+        # the command's outermost boundary: anything unexpected still becomes one line and
+        # exit code 1 (traceback with --debug), never a raw traceback in a user's pipeline
+        except Exception as exc:  # noqa: BLE001
             if debug:
                 traceback.print_exc()
             code, text = _classify(exc)

@@ -46,7 +46,7 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, qui
             raise click.UsageError("--log and --output name the same file")
     source = read_mesh(mesh)
     constraints = load_handles(handles, source.vertices)
-    overrides = dict(alpha=alpha, feedback=feedback, max_iter=max_iter, tol=tol, weights=weights)
+    overrides = {"alpha": alpha, "feedback": feedback, "max_iter": max_iter, "tol": tol, "weights": weights}
     deformed, result, notes = deform_mesh(source, constraints, **overrides)
     mesh_bytes, lost = format_mesh(deformed, os.path.splitext(out)[1].lower())
     files = [(out, mesh_bytes)]

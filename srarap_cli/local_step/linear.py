@@ -47,6 +47,7 @@ class LinearRotorStep:
         self.alpha_area = alpha_area
         self.feedback = feedback
         self.cg_iterations = 0
+        self._last = None
         denom = (graph.degree + feedback).astype(float)
         self._row_scale = denom[self.free]
         adjacency = sp.csr_matrix((np.full(graph.I.size, alpha_area), (graph.I, graph.J)),
@@ -97,14 +98,25 @@ class LinearRotorStep:
                                       R_prev[self.fixed])
         if self.free.size:
             A, b, diag = self.free_system(M, R_prev, R[self.fixed])
-            sol = self._solve(A, b, diag, R_prev[self.free].ravel())
+            sol = self._solve(A, b, diag, self._warm_start(R_prev))
             R[self.free] = normalize(sol.reshape(-1, 4), R_prev[self.free])
+            self._last = (sol, R[self.free])
         return R
 
+    def _warm_start(self, R_prev):
+        """The previous raw (unnormalized) solution when it belongs to these rotors.
+
+        Raw solutions are not unit length; starting CG from the normalized rotors would waste
+        its first iterations on recovering their scale.
+        """
+        if self._last is not None and np.array_equal(self._last[1], R_prev[self.free]):
+            return self._last[0]
+        return R_prev[self.free].ravel()
+
     def _solve(self, A, b, diag, x0):
-        inv = np.linalg.inv(diag)
-        precond = spla.LinearOperator(
-            A.shape, matvec=lambda x: np.einsum("nij,nj->ni", inv, x.reshape(-1, 4)).ravel())
+        nf = diag.shape[0]
+        precond = sp.bsr_matrix((np.linalg.inv(diag), np.arange(nf), np.arange(nf + 1)),
+                                shape=A.shape)
         count = [0]
 
         def tick(_):

@@ -4,8 +4,11 @@ OBJ and OFF are parsed here (meshio fails on common variants of both); PLY and S
 read with meshio. Writers are deterministic (no timestamps) and atomic (temporary file in
 the target folder, then rename), so a failed run never leaves a partial file behind.
 """
+import io
 import os
+import struct
 import warnings
+from contextlib import redirect_stderr, redirect_stdout
 
 import meshio
 import numpy as np
@@ -21,7 +24,10 @@ from .ply import format_ply, mesh_from_meshio, per_vertex
 READ_FORMATS = (".obj", ".off", ".ply", ".stl")
 WRITE_FORMATS = (".obj", ".off", ".ply")
 
-__all__ = ["Mesh", "read_mesh", "write_mesh", "atomic_write", "READ_FORMATS", "WRITE_FORMATS"]
+_MESHIO_FAILURES = (SystemExit, meshio.ReadError, ValueError, IndexError, KeyError, EOFError,
+                    TypeError, struct.error)
+
+__all__ = ["READ_FORMATS", "WRITE_FORMATS", "Mesh", "atomic_write", "read_mesh", "write_mesh"]
 
 
 def _suffix(path):
@@ -57,12 +63,15 @@ def read_mesh(path):
 def _read_meshio(path, suffix):
     if not os.path.isfile(path):
         raise InputError(f"{path}: no such file")
+    chatter = io.StringIO()
     try:
-        with warnings.catch_warnings():
+        # meshio prints its own message and calls sys.exit() on some files it cannot read
+        with warnings.catch_warnings(), redirect_stdout(chatter), redirect_stderr(chatter):
             warnings.simplefilter("ignore")
             m = meshio.read(path, file_format="ply" if suffix == ".ply" else "stl")
-    except Exception as exc:  # meshio raises many types for malformed files
-        raise InputError(f"{path}: not a readable {suffix[1:].upper()} file ({exc})") from None
+    except _MESHIO_FAILURES as exc:
+        detail = str(exc) if not isinstance(exc, SystemExit) else "unrecognized content"
+        raise InputError(f"{path}: not a readable {suffix[1:].upper()} file ({detail})") from None
     return mesh_from_meshio(m)
 
 

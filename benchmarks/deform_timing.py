@@ -1,0 +1,77 @@
+"""Time `srarap deform`'s solver on the shared cases, beside libigl's classic ARAP.
+
+Prints, per case: iterations to reach tol, median seconds per local/global iteration of
+srarap (sr-linear), median seconds per iteration of libigl's ARAP (spokes energy, same
+constraints) measured in the same run, and their ratio. libigl's ARAP is a different energy
+(no bending, per-cell SVD), so the ratio compares iteration cost, not results.
+
+Run: python benchmarks/deform_timing.py [--runs 3] [--tol 1e-6]
+"""
+import argparse
+import os
+import statistics
+import time
+
+import igl
+import numpy as np
+
+from srarap_cli.deformer import Deformer
+from srarap_cli.handles import load_handles
+from srarap_cli.mesh_io import read_mesh
+from srarap_cli.pipeline import settings
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")
+CASES = [
+    ("cylinder (shared .sel/.def)", os.path.join(SHARED, "cylinder.off"),
+     os.path.join(SHARED, "cylinder.sel")),
+    ("spot (configs/spot-nod.yaml)", os.path.join(ROOT, "sample_meshes", "spot.obj"),
+     os.path.join(ROOT, "configs", "spot-nod.yaml")),
+]
+
+
+def srarap_run(V, F, c, tol):
+    opts = settings(c.solver, {"tol": tol})
+    t0 = time.perf_counter()
+    d = Deformer(V, F, c.ids, alpha=opts["alpha"], feedback=opts["feedback"],
+                 weights=opts["weights"])
+    pre = time.perf_counter() - t0
+    r = d.solve(c.targets, max_iter=opts["max_iter"], tol=tol)
+    per_iter = (r.log[-1]["seconds"] - r.log[0]["seconds"]) / max(r.iterations, 1)
+    return pre, per_iter, r
+
+
+def igl_per_iteration(V, F, c, iterations=20):
+    data = igl.ARAPData()
+    data.max_iter = iterations
+    igl.arap_precomputation(V, F, 3, c.ids.astype(np.int32), data)
+    t0 = time.perf_counter()
+    igl.arap_solve(c.targets, data, V.copy())
+    return (time.perf_counter() - t0) / iterations
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--tol", type=float, default=1e-6)
+    args = ap.parse_args()
+    print(f"{'case':32} {'verts':>6} {'iters':>6} {'energy':>10} {'ms/iter':>8} "
+          f"{'igl ms/iter':>11} {'ratio':>6} {'precompute s':>12}")
+    for name, mesh_path, handle_path in CASES:
+        mesh = read_mesh(mesh_path)
+        V, F = mesh.vertices, mesh.triangles()[0]
+        c = load_handles(handle_path, V)
+        ours, peer, pre, result = [], [], [], None
+        for _ in range(args.runs):
+            p, it, result = srarap_run(V, F, c, args.tol)
+            ours.append(it)
+            pre.append(p)
+            peer.append(igl_per_iteration(V, F, c))
+        a, b = statistics.median(ours), statistics.median(peer)
+        print(f"{name:32} {len(V):6d} {result.iterations:6d} {result.energy:10.5g} "
+              f"{1e3 * a:8.1f} {1e3 * b:11.1f} {a / b:6.2f} {statistics.median(pre):12.3f}")
+
+
+if __name__ == "__main__":
+    main()
