@@ -161,3 +161,22 @@ def test_module_entry_point_and_console_script(small, tmp_path):
                        capture_output=True, text=True, check=False)
     assert p.returncode == 4 and "Traceback" not in p.stderr
     assert p.stderr.count("\n") == 1
+
+
+def test_json_handles_and_sel_file_through_the_command(small, tmp_path):
+    mesh, handles = small
+    doc = yaml.safe_load(handles.read_text())
+    (tmp_path / "h.json").write_text(json.dumps(doc))
+    a, b = tmp_path / "a.obj", tmp_path / "b.obj"
+    assert run(mesh, handles, "-o", a, "-q").exit_code == 0
+    assert run(mesh, tmp_path / "h.json", "-o", b, "-q").exit_code == 0
+    assert a.read_bytes() == b.read_bytes()
+    V = read_mesh(str(mesh)).vertices
+    status = np.where(V[:, 2] < 1e-9, 0, np.where(V[:, 2] > 6 - 1e-9, 2, 1))
+    (tmp_path / "c.sel").write_text("# status\n# per vertex\n" + "\n".join(map(str, status)))
+    (tmp_path / "c.def").write_text("# move\n1 0 0 0.5\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    out = tmp_path / "c.off"
+    assert run(mesh, tmp_path / "c.sel", "-o", out, "-q").exit_code == 0
+    P = read_mesh(str(out)).vertices
+    assert np.array_equal(P[status == 0], V[status == 0])
+    assert np.allclose(P[status == 2], V[status == 2] + [0.5, 0, 0], atol=1e-15)

@@ -131,3 +131,16 @@ def test_truncated_off_and_unknown_format_are_invalid_input(tmp_path):
         read_mesh(str(path))
     with pytest.raises(InputError, match="unsupported mesh format"):
         read_mesh(str(tmp_path / "x.vtk"))
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_stl_corners_are_welded_into_shared_vertices(tmp_path, binary):
+    mesh = tube_mesh(rings=3, segments=5)
+    F = mesh.triangles()[0]
+    path = str(tmp_path / "t.stl")
+    meshio.write(path, meshio.Mesh(mesh.vertices, [("triangle", F)]), binary=binary)
+    back = read_mesh(path)
+    assert len(back.vertices) == len(mesh.vertices) and back.face_sizes.size == len(F)
+    tri = back.vertices[back.face_vertices.reshape(-1, 3)]
+    assert np.allclose(np.sort(tri.reshape(-1, 9), axis=0),
+                       np.sort(mesh.vertices[F].reshape(-1, 9).astype(np.float32), axis=0))
