@@ -94,6 +94,11 @@ class Deformer:
         if self.graph.degenerate:
             self.warnings.append(f"{self.graph.degenerate} triangle angles of zero-area faces "
                                  "have no finite cotangent; their weights count as 0")
+        negative = int(np.count_nonzero(self.graph.c < 0)) // 2
+        if negative:
+            self.warnings.append(f"{negative} edges have negative cotangent weights: the membrane "
+                                 "energy is not bounded below and the solve may not settle; "
+                                 "use --weights cotan-clamped (default) or uniform")
         self.auto_fixed = self._unanchored(mask)
         mask[self.auto_fixed] = True
         self._mask = mask

@@ -191,3 +191,10 @@ def test_other_weight_kinds_reach_rigid_motion(bar, weights):
     Rm = to_matrix(from_axis_angle([0, 1, 0], 90))
     r = deform(V, F, ids, V[ids] @ Rm.T, weights=weights, max_iter=3000, tol=1e-12)
     assert np.abs(r.positions - V @ Rm.T).max() < 1e-7
+
+
+def test_negative_cotangent_weights_are_warned_about():
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, 0.1, 0], [0.5, -0.1, 0]])
+    F = np.array([[0, 1, 2], [1, 0, 3]])  # both angles opposite edge 0-1 are obtuse
+    assert any("negative cotangent" in w for w in Deformer(V, F, [0], weights="cotan").warnings)
+    assert not Deformer(V, F, [0]).warnings
