@@ -7,10 +7,10 @@ from scipy.sparse import csgraph
 
 from .energy import bending_energy, membrane_energy
 from .global_step import PoissonSolver
-from .local_step.linear import LinearRotorStep
-from .local_step.membrane import cell_covariance
+from .local_step import METHODS
 from .operators import cell_graph
 from .quaternion import IDENTITY
+from .rest_edges import RestEdges
 
 LOG_FIELDS = ("iteration", "membrane", "bending", "total", "rel_change", "max_move", "seconds")
 
@@ -58,6 +58,10 @@ class Deformer:
     feedback : float >= 0, pull of each rotor toward its previous value (paper's eps)
     weights : {"cotan-clamped", "cotan", "uniform"}
     area : float, optional; ``A`` in the energy, default the surface area of (V, F)
+    method : {"sr-linear", "sr-linear-sym", "sr-relax", "arap"}
+        Local step: the paper's one-solve system, its symmetric total-energy variant,
+        per-cell relaxation sweeps, or classic ARAP (no bending term).
+    sweeps : int, relaxation sweeps per iteration for ``sr-relax``
 
     Attributes
     ----------
@@ -77,7 +81,9 @@ class Deformer:
     """
 
     def __init__(self, V, F, constrained, *, alpha=0.14, feedback=0.2,
-                 weights="cotan-clamped", area=None):
+                 weights="cotan-clamped", area=None, method="sr-linear", sweeps=2):
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
         if not alpha > 0:
             raise ValueError("alpha must be > 0")
         if not feedback >= 0:
@@ -104,12 +110,14 @@ class Deformer:
         self._mask = mask
         self._fixed = np.flatnonzero(mask)
         self._slot = np.searchsorted(self._fixed, self.constrained)
-        q = self.V[self.graph.J] - self.V[self.graph.I]
-        self._rest_edges = q
-        self._rest_sq = np.einsum("ij,ij->i", q, q)
-        self._energy_floor = 1e-14 * max(float(self.graph.c @ self._rest_sq), 1e-300)
+        self.edges = RestEdges(self.graph, self.V)
+        self._energy_floor = 1e-14 * max(float(self.graph.c @ self.edges.q_sq), 1e-300)
         self.poisson = PoissonSolver(self.graph, mask)
-        self.local_step = LinearRotorStep(self.graph, mask, self.alpha * self.area, feedback)
+        step_class = METHODS[method]
+        extra = {"sweeps": sweeps} if method == "sr-relax" else {}
+        self.method = method
+        self.local_step = step_class(self.graph, mask, self.alpha * self.area, feedback, **extra)
+        self._bending_alpha = self.alpha if step_class.bending else 0.0
 
     def _unanchored(self, mask):
         n_parts, label = csgraph.connected_components(self.graph.laplacian, directed=False)
@@ -132,10 +140,11 @@ class Deformer:
 
     def energies(self, P, R):
         """(membrane, bending) energy of positions ``P`` with rotors ``R``."""
-        return (membrane_energy(self.graph, self._rest_edges, P, R),
-                bending_energy(self.graph, R, self.alpha, self.area))
+        return (membrane_energy(self.graph, self.edges.q, P, R),
+                bending_energy(self.graph, R, self._bending_alpha, self.area))
 
-    def solve(self, targets, *, max_iter=200, tol=1e-6, initial=None, callback=None):
+    def solve(self, targets, *, max_iter=200, tol=1e-6, initial=None, callback=None,
+              time_limit=None):
         """Deform toward ``targets`` for the constrained vertices.
 
         Parameters
@@ -146,6 +155,7 @@ class Deformer:
         initial : (positions (n, 3), rotors (n, 4)), optional warm start; default is
             Laplacian editing (identity rotors, one Poisson solve)
         callback : callable(dict), called with each log row
+        time_limit : float, optional; stop (not converged) once this many seconds have passed
 
         Returns
         -------
@@ -156,8 +166,7 @@ class Deformer:
         fixed_targets = self._fixed_targets(targets)
         if initial is None:
             R = np.tile(IDENTITY, (len(self.V), 1))
-            P = self.poisson.solve(self.poisson.rotated_divergence(self._rest_edges, R),
-                                   fixed_targets)
+            P = self.poisson.solve(self.edges.rotated_divergence(R), fixed_targets)
         else:
             P = np.array(initial[0], dtype=float)
             R = np.array(initial[1], dtype=float)
@@ -165,15 +174,16 @@ class Deformer:
         result = DeformResult(P, R)
         self._record(result, P, R, None, start, callback)
         for k in range(1, max_iter + 1):
-            S, s = cell_covariance(self.graph, self._rest_edges, self._rest_sq, P)
-            R = self.local_step(S, s, R)
-            P_new = self.poisson.solve(self.poisson.rotated_divergence(self._rest_edges, R),
-                                       fixed_targets)
+            S, s = self.edges.covariance(P)
+            R = self.local_step.step(S, s, R)
+            P_new = self.poisson.solve(self.edges.rotated_divergence(R), fixed_targets)
             row = self._record(result, P_new, R, P, start, callback)
             P = P_new
             result.iterations = k
             if row["rel_change"] <= tol:
                 result.converged = True
+                break
+            if time_limit is not None and row["seconds"] >= time_limit:
                 break
         result.positions, result.rotors = P, R
         return result

@@ -3,8 +3,6 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .quaternion import rotate
-
 
 class SingularSystemError(RuntimeError):
     """A factorization met a singular matrix (for example a part with no constraint)."""
@@ -44,18 +42,12 @@ class PoissonSolver:
         self._K_fc = K[self.free][:, self.fixed].tocsr()
         self._solve = factor(K[self.free][:, self.free], symmetric=True) if self.free.size else None
 
-    def rotated_divergence(self, rest_edges, R):
-        """``b_i = sum_j c_ij / 2 (R_i q_ij R_i~ + R_j q_ij R_j~)``: (n, 3)."""
-        g = self.graph
-        avg = rotate(R[g.I], rest_edges) + rotate(R[g.J], rest_edges)
-        return g.cell_sum(0.5 * g.c[:, None] * avg)
-
     def solve(self, b, targets):
         """Positions with ``P[fixed] = targets`` minimizing the membrane energy for ``b``.
 
         Parameters
         ----------
-        b : (n, 3) float array, from :meth:`rotated_divergence`
+        b : (n, 3) float array, from :meth:`RestEdges.rotated_divergence`
         targets : (k, 3) float array, positions of the constrained vertices in index order
         """
         P = np.empty((self.graph.n, 3))

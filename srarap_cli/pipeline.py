@@ -1,4 +1,6 @@
 """From a mesh and its constraints to the deformed mesh: the path every command shares."""
+from dataclasses import dataclass
+
 import numpy as np
 
 from .deformer import Deformer, DeformResult
@@ -6,7 +8,8 @@ from .operators import mesh_area
 from .quaternion import IDENTITY
 from .region import restrict
 
-DEFAULTS = {"alpha": 0.14, "feedback": 0.2, "max_iter": 1000, "tol": 1e-6, "weights": "cotan-clamped"}
+DEFAULTS = {"alpha": 0.14, "feedback": 0.2, "max_iter": 1000, "tol": 1e-6,
+            "weights": "cotan-clamped", "method": "sr-linear", "sweeps": 2}
 
 
 def settings(file_settings, overrides):
@@ -17,6 +20,37 @@ def settings(file_settings, overrides):
     return out
 
 
+@dataclass
+class Problem:
+    """The triangle mesh a solve works on (all of it, or the region of interest's part).
+
+    Attributes
+    ----------
+    vertices : (s,) int array, ids in the full mesh
+    V : (s, 3) float array; F : (f, 3) int array, in solve ids
+    ids : (k,) int array, constrained solve ids; targets : (k, 3) float array
+    area : float or None, the whole mesh's area when the solve covers only a region
+    """
+
+    vertices: np.ndarray
+    V: np.ndarray
+    F: np.ndarray
+    ids: np.ndarray
+    targets: np.ndarray
+    area: float = None
+
+
+def problem(mesh, constraints):
+    """Triangulate ``mesh`` and cut it down to the region of interest, if there is one."""
+    V = mesh.vertices
+    F, _ = mesh.triangles()
+    if constraints.region is None:
+        return Problem(np.arange(len(V)), V, F, constraints.ids, constraints.targets)
+    sub = restrict(V, F, constraints.ids, constraints.targets, constraints.region)
+    return Problem(sub.vertices, V[sub.vertices], sub.faces, sub.constrained, sub.targets,
+                   mesh_area(V, F))
+
+
 def deform_mesh(mesh, constraints, callback=None, **overrides):
     """Deform a :class:`~srarap_cli.mesh_io.Mesh` by its :class:`~srarap_cli.handles.Constraints`.
 
@@ -25,7 +59,7 @@ def deform_mesh(mesh, constraints, callback=None, **overrides):
     mesh : Mesh
     constraints : Constraints
     callback : callable(dict), optional, receives each log row
-    **overrides : alpha, feedback, max_iter, tol, weights
+    **overrides : alpha, feedback, max_iter, tol, weights, method, sweeps
 
     Returns
     -------
@@ -34,23 +68,16 @@ def deform_mesh(mesh, constraints, callback=None, **overrides):
     warnings : list of str
     """
     opts = settings(constraints.solver, overrides)
-    V = mesh.vertices
-    F, _ = mesh.triangles()
-    area_all = None
-    if constraints.region is not None:
-        sub = restrict(V, F, constraints.ids, constraints.targets, constraints.region)
-        area_all = mesh_area(V, F)
-        verts, faces, ids, targets = sub.vertices, sub.faces, sub.constrained, sub.targets
-    else:
-        verts, faces, ids, targets = np.arange(len(V)), F, constraints.ids, constraints.targets
-    deformer = Deformer(V[verts], faces, ids, alpha=opts["alpha"], feedback=opts["feedback"],
-                        weights=opts["weights"], area=area_all)
-    sub_result = deformer.solve(targets, max_iter=opts["max_iter"], tol=opts["tol"],
+    p = problem(mesh, constraints)
+    deformer = Deformer(p.V, p.F, p.ids, alpha=opts["alpha"], feedback=opts["feedback"],
+                        weights=opts["weights"], area=p.area, method=opts["method"],
+                        sweeps=opts["sweeps"])
+    sub_result = deformer.solve(p.targets, max_iter=opts["max_iter"], tol=opts["tol"],
                                 callback=callback)
-    positions = V.copy()
-    positions[verts] = sub_result.positions
-    rotors = np.tile(IDENTITY, (len(V), 1))
-    rotors[verts] = sub_result.rotors
+    positions = mesh.vertices.copy()
+    positions[p.vertices] = sub_result.positions
+    rotors = np.tile(IDENTITY, (len(positions), 1))
+    rotors[p.vertices] = sub_result.rotors
     result = DeformResult(positions, rotors, sub_result.log, sub_result.converged,
                           sub_result.iterations)
     return mesh.with_vertices(positions), result, list(deformer.warnings)

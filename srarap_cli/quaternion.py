@@ -47,10 +47,15 @@ def rotate(q, v):
     -------
     (..., 3) float array
     """
-    w = q[..., :1]
-    u = q[..., 1:]
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    w, x, y, z = np.moveaxis(q, -1, 0)
+    vx, vy, vz = np.moveaxis(v, -1, 0)
+    # t = 2 u x v ; v' = v + w t + u x t  (written out: np.cross is slow on small rows)
+    tx = 2 * (y * vz - z * vy)
+    ty = 2 * (z * vx - x * vz)
+    tz = 2 * (x * vy - y * vx)
+    return np.stack([vx + w * tx + y * tz - z * ty,
+                     vy + w * ty + z * tx - x * tz,
+                     vz + w * tz + x * ty - y * tx], axis=-1)
 
 
 def to_matrix(q):
@@ -93,3 +98,33 @@ def normalize(q, fallback):
     out = np.array(fallback, dtype=float, copy=True)
     out[ok] = q[ok] / norm[ok]
     return out
+
+
+def from_matrix(M):
+    """Unit quaternions (n, 4) of rotation matrices (n, 3, 3), with ``w >= 0``.
+
+    Uses the largest of the four squared components to divide by (Shepperd's method), so
+    every rotation, including half turns, converts accurately.
+    """
+    m = np.asarray(M, dtype=float)
+    tr = np.trace(m, axis1=1, axis2=2)
+    d = np.stack([tr, m[:, 0, 0], m[:, 1, 1], m[:, 2, 2]], axis=1)
+    k = np.argmax(np.column_stack([tr, 2 * d[:, 1:] - tr[:, None]]), axis=1)
+    q = np.empty((len(m), 4))
+    r = np.sqrt(np.maximum(1 + np.choose(k, [tr, 2 * d[:, 1] - tr, 2 * d[:, 2] - tr,
+                                             2 * d[:, 3] - tr]), 0)) / 2
+    s = 0.25 / r
+    a = m[:, 2, 1] - m[:, 1, 2]
+    b = m[:, 0, 2] - m[:, 2, 0]
+    c = m[:, 1, 0] - m[:, 0, 1]
+    xy, xz, yz = m[:, 0, 1] + m[:, 1, 0], m[:, 0, 2] + m[:, 2, 0], m[:, 1, 2] + m[:, 2, 1]
+    q[k == 0] = np.column_stack([r, a * s, b * s, c * s])[k == 0]
+    q[k == 1] = np.column_stack([a * s, r, xy * s, xz * s])[k == 1]
+    q[k == 2] = np.column_stack([b * s, xy * s, r, yz * s])[k == 2]
+    q[k == 3] = np.column_stack([c * s, xz * s, yz * s, r])[k == 3]
+    return q * np.where(q[:, :1] < 0, -1.0, 1.0)
+
+
+def align_hemisphere(q, reference):
+    """Flip the sign of rows of ``q`` that point away from ``reference`` (same rotation)."""
+    return q * np.where(np.einsum("ij,ij->i", q, reference) < 0, -1.0, 1.0)[:, None]

@@ -7,7 +7,6 @@ from helpers import ends, random_rotation, symmetric_tube, tube
 from scipy.spatial.transform import Rotation
 
 from srarap_cli.deformer import Deformer, deform
-from srarap_cli.local_step.membrane import cell_covariance
 from srarap_cli.quaternion import IDENTITY, from_axis_angle, multiply, to_matrix
 
 ALPHA = 0.14
@@ -122,8 +121,8 @@ def test_local_step_solves_the_papers_system(bar):
     P = V + 0.2 * rng.normal(size=V.shape)
     R_prev = np.array([random_rotation(rng) * 0.1 + IDENTITY for _ in V])
     R_prev /= np.linalg.norm(R_prev, axis=1, keepdims=True)
-    S, s = cell_covariance(g, d._rest_edges, d._rest_sq, P)
-    got = d.local_step(S, s, R_prev)
+    S, s = d.edges.covariance(P)
+    got = d.local_step.step(S, s, R_prev)
 
     n, aA, eps = len(V), ALPHA * d.area, 0.2
     M = np.zeros((n, 4, 4))

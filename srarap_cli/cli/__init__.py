@@ -1,6 +1,7 @@
 """The ``srarap`` command group; each subcommand lives in its own module."""
 import click
 
+from .bench import bench
 from .deform import deform
 
 
@@ -12,3 +13,4 @@ def main(debug):
 
 
 main.add_command(deform)
+main.add_command(bench)

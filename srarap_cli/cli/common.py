@@ -10,6 +10,7 @@ from .. import exit_codes
 from ..deformer import NumericalError
 from ..errors import InputError, OutputError
 from ..global_step import SingularSystemError
+from ..operators import WEIGHT_KINDS
 
 
 def fail(code, message):
@@ -65,3 +66,27 @@ def check_output_path(path, allowed, what):
         raise OutputError(f"{path}: folder {folder} is not writable")
     if os.path.isdir(path):
         raise OutputError(f"{path}: is a folder")
+
+
+_SOLVER_OPTIONS = [
+    click.option("--alpha", type=click.FloatRange(min=0, min_open=True),
+                 help="Bending weight (energy uses alpha * total area). [default: 0.14]"),
+    click.option("--feedback", type=click.FloatRange(min=0),
+                 help="Pull of each rotor toward its previous value (paper's eps). "
+                      "[default: 0.2]"),
+    click.option("--max-iter", type=click.IntRange(min=0),
+                 help="Local/global iterations at most. [default: 1000]"),
+    click.option("--tol", type=click.FloatRange(min=0),
+                 help="Stop when the relative energy change is at most this. [default: 1e-6]"),
+    click.option("--weights", type=click.Choice(WEIGHT_KINDS),
+                 help="Edge weights. [default: cotan-clamped]"),
+    click.option("--sweeps", type=click.IntRange(min=1),
+                 help="Relaxation sweeps per iteration for sr-relax. [default: 2]"),
+]
+
+
+def solver_options(func):
+    """The solver settings every solving subcommand accepts (None: file or default)."""
+    for option in reversed(_SOLVER_OPTIONS):
+        func = option(func)
+    return func

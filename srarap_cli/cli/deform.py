@@ -5,12 +5,12 @@ import click
 
 from .. import exit_codes
 from ..handles import load_handles
+from ..local_step import METHODS
 from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
-from ..operators import WEIGHT_KINDS
 from ..pipeline import deform_mesh, settings
 from ..solve_log import LOG_FORMATS, format_log
-from .common import check_output_path, guarded
+from .common import check_output_path, guarded, solver_options
 
 
 @click.command("deform")
@@ -20,19 +20,13 @@ from .common import check_output_path, guarded
               help="Deformed mesh to write: .obj, .ply or .off.")
 @click.option("--log", "log", type=click.Path(dir_okay=False),
               help="Per-iteration energy log: .csv or .jsonl.")
-@click.option("--alpha", type=click.FloatRange(min=0, min_open=True),
-              help="Bending weight (energy uses alpha * total area). [default: 0.14]")
-@click.option("--feedback", type=click.FloatRange(min=0),
-              help="Pull of each rotor toward its previous value (paper's eps). [default: 0.2]")
-@click.option("--max-iter", type=click.IntRange(min=0),
-              help="Local/global iterations at most. [default: 1000]")
-@click.option("--tol", type=click.FloatRange(min=0),
-              help="Stop when the relative energy change is at most this. [default: 1e-6]")
-@click.option("--weights", type=click.Choice(WEIGHT_KINDS),
-              help="Edge weights. [default: cotan-clamped]")
+@solver_options
+@click.option("--method", type=click.Choice(tuple(METHODS)),
+              help="Local step (see README). [default: sr-linear]")
 @click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
 @guarded
-def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, quiet):
+def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, method, sweeps,
+           quiet):
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
@@ -46,7 +40,8 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, qui
             raise click.UsageError("--log and --output name the same file")
     source = read_mesh(mesh)
     constraints = load_handles(handles, source.vertices)
-    overrides = {"alpha": alpha, "feedback": feedback, "max_iter": max_iter, "tol": tol, "weights": weights}
+    overrides = {"alpha": alpha, "feedback": feedback, "max_iter": max_iter, "tol": tol,
+                 "weights": weights, "method": method, "sweeps": sweeps}
     deformed, result, notes = deform_mesh(source, constraints, **overrides)
     mesh_bytes, lost = format_mesh(deformed, os.path.splitext(out)[1].lower())
     files = [(out, mesh_bytes)]

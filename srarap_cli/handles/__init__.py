@@ -12,13 +12,14 @@ import numpy as np
 import yaml
 
 from ..errors import InputError
+from ..local_step import METHODS
 from ..operators import WEIGHT_KINDS
 from .fields import Context
 from .formats import read_def, read_sel
 from .selectors import SELECTOR_KEYS, select
 from .transforms import ACTION_KEYS, targets
 
-SOLVER_KEYS = ("alpha", "feedback", "max_iter", "tol", "weights")
+SOLVER_KEYS = ("alpha", "feedback", "max_iter", "tol", "weights", "method", "sweeps")
 TOP_KEYS = ("groups", "region", "solver")
 
 
@@ -134,6 +135,12 @@ def _solver(ctx, spec):
         if spec["weights"] not in WEIGHT_KINDS:
             raise ctx.error(f"weights must be one of {', '.join(WEIGHT_KINDS)}")
         out["weights"] = spec["weights"]
+    if "method" in spec:
+        if spec["method"] not in METHODS:
+            raise ctx.error(f"method must be one of {', '.join(METHODS)}")
+        out["method"] = spec["method"]
+    if "sweeps" in spec:
+        out["sweeps"] = ctx.integer(spec["sweeps"], "sweeps", 1)
     return out
 
 

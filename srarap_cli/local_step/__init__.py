@@ -1,5 +1,18 @@
 """Local steps: given deformed positions, find the cell rotors.
 
-``membrane`` builds the per-vertex 4x4 matrices every method shares; ``linear`` is the
-paper's one-solve rotor system (section 6).
+Every method is a class built once per mesh and constraint set,
+``Step(graph, constrained_mask, alpha * A, feedback, **options)``, whose ``step(S, s, R_prev)``
+returns new unit rotors from the cells' covariances (see ``membrane``). ``bending`` says
+whether the method's energy has the bending term.
 """
+from .arap import ArapRotorStep
+from .linear import LinearRotorStep
+from .linear_sym import SymmetricRotorStep
+from .relax import RelaxRotorStep
+
+METHODS = {
+    "sr-linear": LinearRotorStep,
+    "sr-linear-sym": SymmetricRotorStep,
+    "sr-relax": RelaxRotorStep,
+    "arap": ArapRotorStep,
+}

@@ -4,7 +4,8 @@ For a unit rotor ``r``, rest edge ``q`` and deformed edge ``p`` (pure quaternion
 ``|r q r~ - p|^2 = |r q - p r|^2 = r^T A^T A r`` with ``A = Rmul(q) - Lmul(p)``.
 Because ``q`` and ``p`` are pure, ``A^T A = (|p|^2 + |q|^2) I + 2 Lmul(p) Rmul(q)``, which is
 linear in the 3x3 tensor ``p q^T``. So a cell needs only ``S_i = sum_j c_ij p_ij q_ij^T`` and
-``s_i = sum_j c_ij (|p_ij|^2 + |q_ij|^2)`` (the paper's eq 8.4, in quaternion form).
+``s_i = sum_j c_ij (|p_ij|^2 + |q_ij|^2)`` (the paper's eq 8.4, in quaternion form), which
+:meth:`~srarap_cli.rest_edges.RestEdges.covariance` provides.
 """
 import numpy as np
 
@@ -23,29 +24,6 @@ def _product_basis():
 
 
 _BASIS = _product_basis()
-
-
-def cell_covariance(graph, rest_edges, rest_sq, P):
-    """Cross-covariance ``S_i`` and squared-length sum ``s_i`` of every cell.
-
-    Parameters
-    ----------
-    graph : CellGraph
-    rest_edges : (m, 3) float array, ``q_j - q_i`` per directed edge
-    rest_sq : (m,) float array, ``|q_j - q_i|^2``
-    P : (n, 3) float array, deformed positions
-
-    Returns
-    -------
-    S : (n, 3, 3) float array
-    s : (n,) float array
-    """
-    p = P[graph.J] - P[graph.I]
-    c = graph.c
-    outer = (c[:, None, None] * p[:, :, None]) * rest_edges[:, None, :]
-    S = graph.cell_sum(outer)
-    s = graph.cell_sum(c * (np.einsum("ij,ij->i", p, p) + rest_sq))
-    return S, s
 
 
 def membrane_matrices(S, s):
