@@ -116,7 +116,7 @@ class Deformer:
         step_class = METHODS[method]
         extra = {"sweeps": sweeps} if method == "sr-relax" else {}
         self.method = method
-        self.local_step = step_class(self.graph, mask, self.alpha * self.area, feedback, **extra)
+        self.local_step = step_class(self.edges, mask, self.alpha * self.area, feedback, **extra)
         self._bending_alpha = self.alpha if step_class.bending else 0.0
 
     def _unanchored(self, mask):
@@ -138,9 +138,9 @@ class Deformer:
         full[self._slot] = targets
         return full
 
-    def energies(self, P, R):
-        """(membrane, bending) energy of positions ``P`` with rotors ``R``."""
-        return (membrane_energy(self.graph, self.edges.q, P, R),
+    def energies(self, P, R, p=None):
+        """(membrane, bending) energy of positions ``P`` with rotors ``R`` (``p``: their edges)."""
+        return (membrane_energy(self.graph, self.edges.q, P, R, p),
                 bending_energy(self.graph, R, self._bending_alpha, self.area))
 
     def solve(self, targets, *, max_iter=200, tol=1e-6, initial=None, callback=None,
@@ -172,12 +172,14 @@ class Deformer:
             R = np.array(initial[1], dtype=float)
             P[self._fixed] = fixed_targets
         result = DeformResult(P, R)
-        self._record(result, P, R, None, start, callback)
+        p = self.edges.deformed(P)
+        self._record(result, P, R, p, None, start, callback)
         for k in range(1, max_iter + 1):
-            S, s = self.edges.covariance(P)
+            S, s = self.edges.covariance(P, p)
             R = self.local_step.step(S, s, R)
             P_new = self.poisson.solve(self.edges.rotated_divergence(R), fixed_targets)
-            row = self._record(result, P_new, R, P, start, callback)
+            p = self.edges.deformed(P_new)
+            row = self._record(result, P_new, R, p, P, start, callback)
             P = P_new
             result.iterations = k
             if row["rel_change"] <= tol:
@@ -188,8 +190,8 @@ class Deformer:
         result.positions, result.rotors = P, R
         return result
 
-    def _record(self, result, P, R, P_prev, start, callback):
-        membrane, bending = self.energies(P, R)
+    def _record(self, result, P, R, p, P_prev, start, callback):
+        membrane, bending = self.energies(P, R, p)
         total = membrane + bending
         if not np.isfinite(total):
             raise NumericalError(f"energy became non-finite at iteration {len(result.log)}")

@@ -12,8 +12,8 @@ import numpy as np
 from .quaternion import rotate
 
 
-def membrane_energy(graph, rest_edges, P, R):
-    """``sum_i sum_j c_ij |R_i q_ij R_i~ - p_ij|^2``.
+def membrane_energy(graph, rest_edges, P, R, deformed_edges=None):
+    """``sum_i sum_j c_ij |R_i q_ij R_i~ - p_ij|^2``, from per-edge residuals.
 
     Parameters
     ----------
@@ -21,8 +21,14 @@ def membrane_energy(graph, rest_edges, P, R):
     rest_edges : (m, 3) float array
     P : (n, 3) float array, deformed positions
     R : (n, 4) float array, unit rotors
+    deformed_edges : (m, 3) float array, optional ``p_ij`` when already computed
+
+    Summing residuals (rather than expanding ``|q|^2 + |p|^2 - 2 p.Rq``) keeps the value
+    accurate down to the rounding of the positions, so convergence near a rigid motion is
+    still measurable.
     """
-    residual = rotate(R[graph.I], rest_edges) - (P[graph.J] - P[graph.I])
+    p = P[graph.J] - P[graph.I] if deformed_edges is None else deformed_edges
+    residual = rotate(R[graph.I], rest_edges) - p
     return float(graph.c @ np.einsum("ij,ij->i", residual, residual))
 
 
@@ -32,8 +38,10 @@ def bending_energy(graph, R, alpha, area):
     ``area`` is passed, not read from ``graph``, so that a solve restricted to a region of
     interest keeps the whole mesh's ``A`` and the same meaning of ``alpha``.
     """
+    if alpha == 0:
+        return 0.0
     dots = np.einsum("ij,ij->i", R[graph.I], R[graph.J])
     sq_i = np.einsum("ij,ij->i", R, R)
     # |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b ; the min takes the sign that agrees
     dist = sq_i[graph.I] + sq_i[graph.J] - 2.0 * np.abs(dots)
-    return float(alpha * area * np.sum(np.maximum(dist, 0.0) / graph.degree[graph.I]))
+    return float(alpha * area * (np.maximum(dist, 0.0) @ graph.inv_degree_of_edge))

@@ -45,6 +45,13 @@ class CellGraph:
     def n(self):
         return self.degree.shape[0]
 
+    @property
+    def inv_degree_of_edge(self):
+        """``1 / deg_i`` for each directed edge ``i -> j``: (m,)."""
+        if not hasattr(self, "_inv_degree_of_edge"):
+            object.__setattr__(self, "_inv_degree_of_edge", 1.0 / self.degree[self.I])
+        return self._inv_degree_of_edge
+
     def cell_sum(self, values):
         """Sum per-edge ``values`` of shape (m, ...) into their source vertex: (n, ...)."""
         flat = values.reshape(values.shape[0], -1)

@@ -12,6 +12,7 @@ class RestEdges:
     ----------
     q : (m, 3) float array; q_sq : (m,) float array
     sum_cq : (n, 3) float array, ``a_i = sum_j c_ij q_ij``
+    rest_scale : (n,) float array, ``sum_j c_ij |q_ij|^2``, the size of a cell's membrane term
 
     Examples
     --------
@@ -29,7 +30,7 @@ class RestEdges:
         self.q_sq = np.einsum("ij,ij->i", self.q, self.q)
         n, c = graph.n, graph.c
         self.sum_cq = graph.cell_sum(c[:, None] * self.q)
-        self._rest_sq = graph.cell_sum(c * self.q_sq)
+        self.rest_scale = graph.cell_sum(c * self.q_sq)
         # G_b[i, j] = c_ij q_ij[b], stacked over b: (3n, n); and side by side over b: (n, 3n)
         self._stack = sp.vstack([sp.csr_matrix((c * self.q[:, b], (graph.I, graph.J)), shape=(n, n))
                                  for b in range(3)]).tocsr()
@@ -38,13 +39,20 @@ class RestEdges:
                                      np.concatenate([3 * graph.J + b for b in range(3)]))),
                                    shape=(n, 3 * n))
 
-    def covariance(self, P):
-        """``S_i = sum_j c_ij p_ij q_ij^T`` (n, 3, 3) and ``s_i = sum_j c_ij(|p|^2 + |q|^2)``."""
+    def deformed(self, P):
+        """Deformed edge vectors ``p_ij = p_j - p_i``: (m, 3)."""
+        return P[self.graph.J] - P[self.graph.I]
+
+    def covariance(self, P, p=None):
+        """``S_i = sum_j c_ij p_ij q_ij^T`` (n, 3, 3) and ``s_i = sum_j c_ij(|p|^2 + |q|^2)``.
+
+        ``p`` (from :meth:`deformed`) may be passed when the caller has it already.
+        """
         g = self.graph
         GP = (self._stack @ P).reshape(3, g.n, 3)  # [b, i, a] = sum_j c q[b] P_j[a]
         S = GP.transpose(1, 2, 0) - P[:, :, None] * self.sum_cq[:, None, :]
-        p = P[g.J] - P[g.I]
-        s = g.cell_sum(g.c * np.einsum("ij,ij->i", p, p)) + self._rest_sq
+        p = self.deformed(P) if p is None else p
+        s = g.cell_sum(g.c * np.einsum("ij,ij->i", p, p)) + self.rest_scale
         return S, s
 
     def rotated_divergence(self, R):

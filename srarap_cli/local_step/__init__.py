@@ -1,7 +1,7 @@
 """Local steps: given deformed positions, find the cell rotors.
 
 Every method is a class built once per mesh and constraint set,
-``Step(graph, constrained_mask, alpha * A, feedback, **options)``, whose ``step(S, s, R_prev)``
+``Step(rest_edges, constrained_mask, alpha * A, feedback, **options)``, whose ``step(S, s, R_prev)``
 returns new unit rotors from the cells' covariances (see ``membrane``). ``bending`` says
 whether the method's energy has the bending term.
 """

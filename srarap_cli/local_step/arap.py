@@ -23,7 +23,7 @@ class ArapRotorStep:
 
     bending = False
 
-    def __init__(self, graph, constrained, alpha_area, feedback):
+    def __init__(self, edges, constrained, alpha_area, feedback):
         pass
 
     def step(self, S, s, R_prev):

@@ -13,12 +13,13 @@ from .rotor_system import RotorSystem
 
 
 class LinearRotorStep(RotorSystem):
-    """The paper's rotor system. Parameters: graph, constrained mask, ``alpha*A``, ``eps``."""
+    """The paper's rotor system. Parameters: rest edges, constrained mask, ``alpha*A``, ``eps``."""
 
     bending = True
 
-    def __init__(self, graph, constrained, alpha_area, feedback):
+    def __init__(self, edges, constrained, alpha_area, feedback):
+        graph = edges.graph
         scale = (graph.degree + feedback).astype(float)
-        super().__init__(graph, constrained, sigma=scale, tau=scale * alpha_area,
+        super().__init__(edges, constrained, sigma=scale, tau=scale * alpha_area,
                          phi=np.full(graph.n, alpha_area * feedback),
                          omega=np.full(graph.I.size, alpha_area))

@@ -19,13 +19,14 @@ def symmetric_weights(graph):
 
 
 class SymmetricRotorStep(RotorSystem):
-    """Total-energy rotor system. Parameters: graph, constrained mask, ``alpha*A``, ``eps``."""
+    """Total-energy rotor system. Parameters: rest edges, constrained mask, ``alpha*A``, ``eps``."""
 
     bending = True
 
-    def __init__(self, graph, constrained, alpha_area, feedback):
+    def __init__(self, edges, constrained, alpha_area, feedback):
+        graph = edges.graph
         W = symmetric_weights(graph)
         row_sum = graph.cell_sum(W)
         prox = alpha_area * feedback / graph.degree.clip(min=1)
-        super().__init__(graph, constrained, sigma=np.ones(graph.n),
+        super().__init__(edges, constrained, sigma=np.ones(graph.n),
                          tau=alpha_area * row_sum + prox, phi=prox, omega=alpha_area * W)

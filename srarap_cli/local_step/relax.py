@@ -87,7 +87,7 @@ class RelaxRotorStep:
 
     Parameters
     ----------
-    graph : CellGraph
+    edges : RestEdges
     constrained : (n,) bool array (unused: every cell relaxes; positions carry the constraints)
     alpha_area : float
     feedback : float
@@ -96,7 +96,8 @@ class RelaxRotorStep:
 
     bending = True
 
-    def __init__(self, graph, constrained, alpha_area, feedback, sweeps=2):
+    def __init__(self, edges, constrained, alpha_area, feedback, sweeps=2):
+        graph = edges.graph
         W = symmetric_weights(graph)
         self._W = sp.csr_matrix((alpha_area * W, (graph.I, graph.J)), shape=(graph.n,) * 2)
         self._phi = alpha_area * feedback / graph.degree.clip(min=1)

@@ -3,9 +3,15 @@
 Row ``i`` (free vertex) reads ``(sigma_i M_i + tau_i I) R_i - sum_j omega_ij R_j = phi_i R_i^prev``
 with symmetric edge weights ``omega``; columns of constrained vertices move to the right-hand
 side. Rows are strictly block diagonally dominant (``tau_i > sum_j omega_ij``, ``M_i`` PSD), so
-the matrix is symmetric positive definite: conjugate gradients with a block-Jacobi
-preconditioner, warm-started from the previous raw solution, to relative residual 1e-10; a
-direct factorization takes over should CG stall.
+the matrix is symmetric positive definite, solved by conjugate gradients to relative residual
+1e-10, warm-started from the previous raw solution; a direct factorization takes over should
+CG stall.
+
+Preconditioner: ``alpha A`` grows with the mesh while ``M_i`` does not, so the system is mostly
+the graph coupling ``omega`` (a shifted Laplacian, poorly served by block-Jacobi: 50 to 300 CG
+iterations). The scalar matrix ``diag(tau_i + sigma_i m_i) - omega`` with ``m_i`` the cell's rest
+membrane scale is factored once per mesh; applied to the four quaternion components it brings
+CG to 5 to 10 iterations on the shared meshes.
 """
 import numpy as np
 import scipy.sparse as sp
@@ -24,13 +30,14 @@ class RotorSystem:
 
     Parameters
     ----------
-    graph : CellGraph
+    edges : RestEdges
     constrained : (n,) bool array
     sigma, tau, phi : (n,) float arrays, per-row scale of ``M_i``, diagonal term, feedback
     omega : (m,) float array, symmetric edge weights aligned with ``graph.I, graph.J``
     """
 
-    def __init__(self, graph, constrained, sigma, tau, phi, omega):
+    def __init__(self, edges, constrained, sigma, tau, phi, omega):
+        graph = edges.graph
         self.free = np.flatnonzero(~constrained)
         self.fixed = np.flatnonzero(constrained)
         self.sigma, self.tau, self.phi = sigma, tau, phi
@@ -39,7 +46,10 @@ class RotorSystem:
         W = sp.csr_matrix((omega, (graph.I, graph.J)), shape=(graph.n,) * 2)
         self._fixed_rows = W[self.fixed]
         self._free_to_fixed = W[self.free][:, self.fixed].tocsr()
-        self._build_pattern(W[self.free][:, self.free].tocoo())
+        W_ff = W[self.free][:, self.free]
+        self._build_pattern(W_ff.tocoo())
+        scalar = sp.diags(tau[self.free] + sigma[self.free] * edges.rest_scale[self.free]) - W_ff
+        self._precondition = factor(scalar, symmetric=True) if self.free.size else None
 
     def _build_pattern(self, free_adj):
         nf = self.free.size
@@ -84,15 +94,15 @@ class RotorSystem:
             x0 = (self._last[0] if self._last is not None
                   and np.array_equal(self._last[1], R_prev[self.free])
                   else R_prev[self.free].ravel())  # raw solutions are not unit length
-            sol = self._solve(A, b, D[self.free], x0)
+            sol = self._solve(A, b, x0)
             R[self.free] = normalize(sol.reshape(-1, 4), R_prev[self.free])
             self._last = (sol, R[self.free])
         return R
 
-    def _solve(self, A, b, blocks, x0):
-        nf = blocks.shape[0]
-        precond = sp.bsr_matrix((np.linalg.inv(blocks), np.arange(nf), np.arange(nf + 1)),
-                                shape=A.shape)
+    def _solve(self, A, b, x0):
+        solve = self._precondition
+        precond = spla.LinearOperator(
+            A.shape, matvec=lambda v: solve(np.asfortranarray(v.reshape(-1, 4))).ravel())
         count = [0]
 
         def tick(_):
