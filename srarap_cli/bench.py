@@ -63,6 +63,7 @@ def _run_igl(V, F, ids, targets, time_budget, max_iter):
     t0 = time.perf_counter()
     data = igl.ARAPData()
     data.max_iter = 1
+    data.energy = igl.ARAP_ENERGY_TYPE_SPOKES  # its default for 3D surfaces is spokes-and-rims
     igl.arap_precomputation(V, F, 3, ids.astype(np.int32), data)
     pre = time.perf_counter() - t0
     scorer = Deformer(V, F, ids, weights="cotan", method="arap")
