@@ -5,11 +5,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.sparse import csgraph
 
-from .energy import bending_energy, membrane_energy
+from .energy import (
+    accurate_enough,
+    bending_energy,
+    membrane_energy,
+    membrane_from_covariance,
+)
 from .global_step import PoissonSolver
 from .local_step import METHODS
 from .operators import cell_graph
-from .quaternion import IDENTITY
+from .quaternion import IDENTITY, to_matrix
 from .rest_edges import RestEdges
 
 LOG_FIELDS = ("iteration", "membrane", "bending", "total", "rel_change", "max_move", "seconds")
@@ -96,18 +101,9 @@ class Deformer:
         self.constrained = np.asarray(constrained, dtype=np.int64).ravel()
         mask = np.zeros(len(self.V), dtype=bool)
         mask[self.constrained] = True
-        self.warnings = []
-        if self.graph.degenerate:
-            self.warnings.append(f"{self.graph.degenerate} triangle angles of zero-area faces "
-                                 "have no finite cotangent; their weights count as 0")
-        negative = int(np.count_nonzero(self.graph.c < 0)) // 2
-        if negative:
-            self.warnings.append(f"{negative} edges have negative cotangent weights: the membrane "
-                                 "energy is not bounded below and the solve may not settle; "
-                                 "use --weights cotan-clamped (default) or uniform")
+        self.warnings = _weight_warnings(self.graph)
         self.auto_fixed = self._unanchored(mask)
         mask[self.auto_fixed] = True
-        self._mask = mask
         self._fixed = np.flatnonzero(mask)
         self._slot = np.searchsorted(self._fixed, self.constrained)
         self.edges = RestEdges(self.graph, self.V)
@@ -138,11 +134,6 @@ class Deformer:
         full[self._slot] = targets
         return full
 
-    def energies(self, P, R, p=None):
-        """(membrane, bending) energy of positions ``P`` with rotors ``R`` (``p``: their edges)."""
-        return (membrane_energy(self.graph, self.edges.q, P, R, p),
-                bending_energy(self.graph, R, self._bending_alpha, self.area))
-
     def solve(self, targets, *, max_iter=200, tol=1e-6, initial=None, callback=None,
               time_limit=None):
         """Deform toward ``targets`` for the constrained vertices.
@@ -172,14 +163,14 @@ class Deformer:
             R = np.array(initial[1], dtype=float)
             P[self._fixed] = fixed_targets
         result = DeformResult(P, R)
-        p = self.edges.deformed(P)
-        self._record(result, P, R, p, None, start, callback)
+        state = self._state(P, R)
+        self._record(result, state, None, tol, start, callback)
         for k in range(1, max_iter + 1):
-            S, s = self.edges.covariance(P, p)
-            R = self.local_step.step(S, s, R)
-            P_new = self.poisson.solve(self.edges.rotated_divergence(R), fixed_targets)
-            p = self.edges.deformed(P_new)
-            row = self._record(result, P_new, R, p, P, start, callback)
+            R = self.local_step.step(state["S"], state["s"], R)
+            Rm = to_matrix(R)
+            P_new = self.poisson.solve(self.edges.rotated_divergence(R, Rm), fixed_targets)
+            state = self._state(P_new, R, Rm)
+            row = self._record(result, state, P, tol, start, callback)
             P = P_new
             result.iterations = k
             if row["rel_change"] <= tol:
@@ -190,8 +181,26 @@ class Deformer:
         result.positions, result.rotors = P, R
         return result
 
-    def _record(self, result, P, R, p, P_prev, start, callback):
-        membrane, bending = self.energies(P, R, p)
+    def _state(self, P, R, Rm=None):
+        """What an iteration knows about positions ``P`` with rotors ``R``: edges, covariances
+        (also the next local step's input) and rotation matrices."""
+        p = self.edges.deformed(P)
+        S, s = self.edges.covariance(P, p)
+        return {"P": P, "R": R, "p": p, "S": S, "s": s,
+                "Rm": to_matrix(R) if Rm is None else Rm}
+
+    def _membrane(self, st, tol):
+        """Membrane energy from the covariances when that is accurate enough for ``tol``,
+        else from the per-edge residuals (near-rigid shapes, ``tol`` 0)."""
+        fast = membrane_from_covariance(st["S"], st["s"], st["Rm"])
+        if accurate_enough(fast, float(st["s"].sum()), tol):
+            return fast
+        return membrane_energy(self.graph, self.edges.q, st["P"], st["R"], st["p"])
+
+    def _record(self, result, st, P_prev, tol, start, callback):
+        P = st["P"]
+        membrane = self._membrane(st, tol)
+        bending = bending_energy(self.graph, st["R"], self._bending_alpha, self.area)
         total = membrane + bending
         if not np.isfinite(total):
             raise NumericalError(f"energy became non-finite at iteration {len(result.log)}")
@@ -201,12 +210,26 @@ class Deformer:
             previous = result.log[-1]["total"]
             rel = abs(total - previous) / max(previous, self._energy_floor)
             move = float(np.sqrt(np.max(np.sum((P - P_prev) ** 2, axis=1), initial=0.0)))
-        row = {"iteration": len(result.log), "membrane": membrane, "bending": bending, "total": total,
-                   "rel_change": rel, "max_move": move, "seconds": time.perf_counter() - start}
+        row = {"iteration": len(result.log), "membrane": membrane, "bending": bending,
+               "total": total, "rel_change": rel, "max_move": move,
+               "seconds": time.perf_counter() - start}
         result.log.append(row)
         if callback is not None:
             callback(row)
         return row
+
+
+def _weight_warnings(graph):
+    out = []
+    if graph.degenerate:
+        out.append(f"{graph.degenerate} triangle angles of zero-area faces have no finite "
+                   "cotangent; their weights count as 0")
+    negative = int(np.count_nonzero(graph.c < 0)) // 2
+    if negative:
+        out.append(f"{negative} edges have negative cotangent weights: the membrane energy is "
+                   "not bounded below and the solve may not settle; use --weights "
+                   "cotan-clamped (default) or uniform")
+    return out
 
 
 def deform(V, F, constrained, targets, **options):

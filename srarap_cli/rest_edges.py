@@ -55,9 +55,12 @@ class RestEdges:
         s = g.cell_sum(g.c * np.einsum("ij,ij->i", p, p)) + self.rest_scale
         return S, s
 
-    def rotated_divergence(self, R):
-        """``b_i = sum_j c_ij / 2 (R_i q_ij R_i~ + R_j q_ij R_j~)``: (n, 3)."""
-        Rm = to_matrix(R)
+    def rotated_divergence(self, R, Rm=None):
+        """``b_i = sum_j c_ij / 2 (R_i q_ij R_i~ + R_j q_ij R_j~)``: (n, 3).
+
+        ``Rm`` (rotation matrices of ``R``) may be passed when the caller has them.
+        """
+        Rm = to_matrix(R) if Rm is None else Rm
         own = np.einsum("nab,nb->na", Rm, self.sum_cq)
         others = self._side @ Rm.transpose(0, 2, 1).reshape(-1, 3)  # [i, a]
         return 0.5 * (own + others)
