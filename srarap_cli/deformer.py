@@ -63,8 +63,9 @@ class Deformer:
     feedback : float >= 0, pull of each rotor toward its previous value (paper's eps)
     weights : {"cotan-clamped", "cotan", "uniform"}
     area : float, optional; ``A`` in the energy, default the surface area of (V, F)
-    method : {"sr-linear", "sr-linear-sym", "sr-relax", "arap"}
-        Local step: the paper's one-solve system, its symmetric total-energy variant,
+    method : {"sr-linear-sym", "sr-linear", "sr-relax", "arap"}
+        Local step: the symmetric total-energy variant of the paper's one-solve system (the
+        default: fastest to a given energy on the benchmarks), the paper's system itself,
         per-cell relaxation sweeps, or classic ARAP (no bending term).
     sweeps : int, relaxation sweeps per iteration for ``sr-relax``
 
@@ -86,7 +87,7 @@ class Deformer:
     """
 
     def __init__(self, V, F, constrained, *, alpha=0.14, feedback=0.2,
-                 weights="cotan-clamped", area=None, method="sr-linear", sweeps=2):
+                 weights="cotan-clamped", area=None, method="sr-linear-sym", sweeps=2):
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
         if not alpha > 0:

@@ -27,8 +27,11 @@ def membrane_energy(graph, rest_edges, P, R, deformed_edges=None):
     accurate down to the rounding of the positions, so convergence near a rigid motion is
     still measurable.
     """
-    p = P[graph.J] - P[graph.I] if deformed_edges is None else deformed_edges
-    residual = rotate(R[graph.I], rest_edges) - p
+    if deformed_edges is None:
+        p = np.take(P, graph.J, axis=0) - np.take(P, graph.I, axis=0)
+    else:
+        p = deformed_edges
+    residual = rotate(np.take(R, graph.I, axis=0), rest_edges) - p
     return float(graph.c @ np.einsum("ij,ij->i", residual, residual))
 
 
@@ -60,8 +63,8 @@ def bending_energy(graph, R, alpha, area):
     """
     if alpha == 0:
         return 0.0
-    dots = np.einsum("ij,ij->i", R[graph.I], R[graph.J])
-    sq_i = np.einsum("ij,ij->i", R, R)
+    dots = np.einsum("ij,ij->i", np.take(R, graph.I, axis=0), np.take(R, graph.J, axis=0))
+    sq = np.einsum("ij,ij->i", R, R)
     # |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b ; the min takes the sign that agrees
-    dist = sq_i[graph.I] + sq_i[graph.J] - 2.0 * np.abs(dots)
+    dist = np.take(sq, graph.I) + np.take(sq, graph.J) - 2.0 * np.abs(dots)
     return float(alpha * area * (np.maximum(dist, 0.0) @ graph.inv_degree_of_edge))

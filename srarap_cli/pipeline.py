@@ -9,7 +9,7 @@ from .quaternion import IDENTITY
 from .region import restrict
 
 DEFAULTS = {"alpha": 0.14, "feedback": 0.2, "max_iter": 1000, "tol": 1e-6,
-            "weights": "cotan-clamped", "method": "sr-linear", "sweeps": 2}
+            "weights": "cotan-clamped", "method": "sr-linear-sym", "sweeps": 2}
 
 
 def settings(file_settings, overrides):

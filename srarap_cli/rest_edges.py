@@ -41,7 +41,8 @@ class RestEdges:
 
     def deformed(self, P):
         """Deformed edge vectors ``p_ij = p_j - p_i``: (m, 3)."""
-        return P[self.graph.J] - P[self.graph.I]
+        # np.take: about four times faster than fancy indexing for row gathers
+        return np.take(P, self.graph.J, axis=0) - np.take(P, self.graph.I, axis=0)
 
     def covariance(self, P, p=None):
         """``S_i = sum_j c_ij p_ij q_ij^T`` (n, 3, 3) and ``s_i = sum_j c_ij(|p|^2 + |q|^2)``.

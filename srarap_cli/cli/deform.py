@@ -22,7 +22,7 @@ from .common import check_output_path, guarded, solver_options
               help="Per-iteration energy log: .csv or .jsonl.")
 @solver_options
 @click.option("--method", type=click.Choice(tuple(METHODS)),
-              help="Local step (see README). [default: sr-linear]")
+              help="Local step (see README). [default: sr-linear-sym]")
 @click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
 @guarded
 def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, method, sweeps,
