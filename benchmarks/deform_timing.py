@@ -1,11 +1,12 @@
 """Time `srarap deform`'s solver on the shared cases, beside libigl's classic ARAP.
 
 Prints, per case: iterations to reach tol, median seconds per local/global iteration of
-srarap (sr-linear), median seconds per iteration of libigl's ARAP (spokes energy, same
-constraints) measured in the same run, and their ratio. libigl's ARAP is a different energy
-(no bending, per-cell SVD), so the ratio compares iteration cost, not results.
+srarap (the chosen method), median seconds per iteration of libigl's ARAP (spokes energy,
+same constraints) measured in the same run, and their ratio. libigl's ARAP is a different
+energy (no bending, per-cell rotation fit), so the ratio compares iteration cost, not results.
+For the method comparison on wall time to a given energy, see run_bench.py.
 
-Run: python benchmarks/deform_timing.py [--runs 3] [--tol 1e-6]
+Run: python benchmarks/deform_timing.py [--runs 3] [--tol 1e-6] [--method sr-linear-sym]
 """
 import argparse
 import os
@@ -31,11 +32,11 @@ CASES = [
 ]
 
 
-def srarap_run(V, F, c, tol):
-    opts = settings(c.solver, {"tol": tol})
+def srarap_run(V, F, c, tol, method):
+    opts = settings(c.solver, {"tol": tol, "method": method})
     t0 = time.perf_counter()
     d = Deformer(V, F, c.ids, alpha=opts["alpha"], feedback=opts["feedback"],
-                 weights=opts["weights"])
+                 weights=opts["weights"], method=opts["method"])
     pre = time.perf_counter() - t0
     r = d.solve(c.targets, max_iter=opts["max_iter"], tol=tol)
     per_iter = (r.log[-1]["seconds"] - r.log[0]["seconds"]) / max(r.iterations, 1)
@@ -45,6 +46,7 @@ def srarap_run(V, F, c, tol):
 def igl_per_iteration(V, F, c, iterations=20):
     data = igl.ARAPData()
     data.max_iter = iterations
+    data.energy = igl.ARAP_ENERGY_TYPE_SPOKES
     igl.arap_precomputation(V, F, 3, c.ids.astype(np.int32), data)
     t0 = time.perf_counter()
     igl.arap_solve(c.targets, data, V.copy())
@@ -55,6 +57,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--tol", type=float, default=1e-6)
+    ap.add_argument("--method", default=None, help="default: the handle file's or srarap's")
     args = ap.parse_args()
     print(f"{'case':32} {'verts':>6} {'iters':>6} {'energy':>10} {'ms/iter':>8} "
           f"{'igl ms/iter':>11} {'ratio':>6} {'precompute s':>12}")
@@ -64,7 +67,7 @@ def main():
         c = load_handles(handle_path, V)
         ours, peer, pre, result = [], [], [], None
         for _ in range(args.runs):
-            p, it, result = srarap_run(V, F, c, args.tol)
+            p, it, result = srarap_run(V, F, c, args.tol, args.method)
             ours.append(it)
             pre.append(p)
             peer.append(igl_per_iteration(V, F, c))
