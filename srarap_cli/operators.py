@@ -6,6 +6,9 @@ import numpy as np
 import scipy.sparse as sp
 
 WEIGHT_KINDS = ("cotan", "cotan-clamped", "uniform")
+# Half-cotangents are bounded: an angle under ~0.06 degrees (a needle) would otherwise give
+# a weight that swamps its neighbours and the conditioning of every solve.
+MAX_HALF_COT = 500.0
 
 
 @dataclass(frozen=True)
@@ -93,7 +96,7 @@ def cell_graph(V, F, weights="cotan-clamped"):
     cols = np.concatenate([F[:, 2], F[:, 0], F[:, 1]])
     vals = half_cot.T.ravel()
     finite = np.isfinite(vals)
-    vals = np.where(finite, vals, 0.0)
+    vals = np.clip(np.where(finite, vals, 0.0), -MAX_HALF_COT, MAX_HALF_COT)
     W = sp.coo_matrix((np.concatenate([vals, vals]),
                        (np.concatenate([rows, cols]), np.concatenate([cols, rows]))),
                       shape=(n, n)).tocsr()

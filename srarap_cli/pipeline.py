@@ -4,6 +4,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .deformer import Deformer, DeformResult
+from .mesh_checks import mesh_warnings, solvable_faces
 from .operators import mesh_area
 from .quaternion import IDENTITY
 from .region import restrict
@@ -41,9 +42,10 @@ class Problem:
 
 
 def problem(mesh, constraints):
-    """Triangulate ``mesh`` and cut it down to the region of interest, if there is one."""
+    """Triangulate ``mesh`` (faces that repeat a vertex left out) and cut it down to the
+    region of interest, if there is one."""
     V = mesh.vertices
-    F, _ = mesh.triangles()
+    F = solvable_faces(mesh.triangles()[0])
     if constraints.region is None:
         return Problem(np.arange(len(V)), V, F, constraints.ids, constraints.targets)
     sub = restrict(V, F, constraints.ids, constraints.targets, constraints.region)
@@ -80,4 +82,5 @@ def deform_mesh(mesh, constraints, callback=None, **overrides):
     rotors[p.vertices] = sub_result.rotors
     result = DeformResult(positions, rotors, sub_result.log, sub_result.converged,
                           sub_result.iterations)
-    return mesh.with_vertices(positions), result, list(deformer.warnings)
+    notes = mesh_warnings(mesh.vertices, mesh.triangles()[0]) + list(deformer.warnings)
+    return mesh.with_vertices(positions), result, notes

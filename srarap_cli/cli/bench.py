@@ -7,6 +7,7 @@ from ..bench import ALL_METHODS, IGL, run_methods
 from ..bench_report import curves_csv, plot_png, summary_json, table
 from ..errors import OutputError
 from ..handles import load_handles
+from ..limits import check_solve
 from ..mesh_io import read_mesh
 from ..mesh_io.commit import commit_files
 from ..pipeline import problem, settings
@@ -16,8 +17,8 @@ CHOICES = ALL_METHODS + (IGL,)
 
 
 @click.command("bench")
-@click.argument("mesh", type=click.Path(dir_okay=False))
-@click.argument("handles", type=click.Path(dir_okay=False))
+@click.argument("mesh")
+@click.argument("handles")
 @click.option("--methods", default=",".join(CHOICES), show_default=True,
               help=f"Comma-separated, from: {', '.join(CHOICES)}.")
 @click.option("--time-budget", type=click.FloatRange(min=0, min_open=True), default=30.0,
@@ -42,6 +43,7 @@ def bench(mesh, handles, methods, time_budget, out, alpha, feedback, max_iter, t
     if out is not None:
         _prepare_folder(out)
     source = read_mesh(mesh)
+    check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
     opts = settings(constraints.solver, {"alpha": alpha, "feedback": feedback,
                                          "weights": weights, "sweeps": sweeps})

@@ -1,10 +1,13 @@
 """What every subcommand shares: error-to-exit-code mapping and output preflight."""
 import functools
 import os
+import signal
 import sys
+import threading
 import traceback
 
 import click
+import numpy as np
 
 from .. import exit_codes
 from ..deformer import NumericalError
@@ -18,14 +21,27 @@ def fail(code, message):
     sys.exit(code)
 
 
+class Terminated(BaseException):
+    """SIGTERM arrived; raised so that cleanup (temporary files) runs on the way out."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
 def guarded(func):
     """Turn known failures into one stderr line and a documented exit code."""
 
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
         debug = click.get_current_context().find_root().params.get("debug", False)
+        if threading.current_thread() is threading.main_thread():  # signals: main thread only
+            signal.signal(signal.SIGTERM, _on_sigterm)
         try:
-            return func(*args, **kwargs)
+            # non-finite results are detected and reported as numerical failures; numpy's own
+            # floating-point warnings would only add multi-line noise to stderr
+            with np.errstate(all="ignore"):
+                return func(*args, **kwargs)
         except (click.exceptions.Exit, click.ClickException, SystemExit):
             raise
         # the command's outermost boundary: anything unexpected still becomes one line and
@@ -37,6 +53,8 @@ def guarded(func):
             fail(code, text)
         except KeyboardInterrupt:
             fail(exit_codes.INTERRUPTED, "interrupted; no output written")
+        except Terminated:
+            fail(exit_codes.TERMINATED, "terminated; no output written")
 
     return wrapper
 

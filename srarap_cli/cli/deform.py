@@ -5,6 +5,7 @@ import click
 
 from .. import exit_codes
 from ..handles import load_handles
+from ..limits import check_solve
 from ..local_step import METHODS
 from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
@@ -14,8 +15,8 @@ from .common import check_output_path, guarded, solver_options
 
 
 @click.command("deform")
-@click.argument("mesh", type=click.Path(dir_okay=False))
-@click.argument("handles", type=click.Path(dir_okay=False))
+@click.argument("mesh")
+@click.argument("handles")
 @click.option("-o", "--output", "out", required=True, type=click.Path(dir_okay=False),
               help="Deformed mesh to write: .obj, .ply or .off.")
 @click.option("--log", "log", type=click.Path(dir_okay=False),
@@ -39,6 +40,7 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, met
         if os.path.abspath(log) == os.path.abspath(out):
             raise click.UsageError("--log and --output name the same file")
     source = read_mesh(mesh)
+    check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
     overrides = {"alpha": alpha, "feedback": feedback, "max_iter": max_iter, "tol": tol,
                  "weights": weights, "method": method, "sweeps": sweeps}

@@ -57,6 +57,8 @@ def load_handles(path, V):
     Constraints
     """
     path = str(path)
+    if os.path.isdir(path):
+        raise InputError(f"{path}: is a folder, not a handle file")
     if path.lower().endswith(".sel"):
         return _from_sel(path, V)
     return parse_handles(_load_document(path), V, path, os.path.dirname(os.path.abspath(path)))

@@ -14,6 +14,7 @@ import meshio
 import numpy as np
 
 from ..errors import InputError, OutputError
+from ..limits import check_read
 from .commit import commit_files
 from .mesh import Mesh
 from .normals import recompute_normals
@@ -45,6 +46,9 @@ def read_mesh(path):
     if suffix not in READ_FORMATS:
         raise InputError(f"{path}: unsupported mesh format {suffix or '(none)'!r}; "
                          f"use one of {', '.join(READ_FORMATS)}")
+    if os.path.isdir(path):
+        raise InputError(f"{path}: is a folder, not a mesh file")
+    check_read(path)
     try:
         if suffix == ".obj":
             mesh = read_obj(path)

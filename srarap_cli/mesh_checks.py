@@ -1,0 +1,60 @@
+"""Mesh problems the solve survives, reported as warnings with counts."""
+import igl
+import numpy as np
+
+NEEDLE_DEGREES = 1.0
+
+
+def solvable_faces(F):
+    """Triangles without a repeated vertex (those have no area and no edge to speak of)."""
+    return F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
+
+
+def mesh_warnings(V, F):
+    """Warning lines for duplicate faces, collapsed, zero-area and needle triangles, and
+    non-manifold edges and vertices of a triangle mesh (V (n, 3), F (f, 3)).
+
+    Examples
+    --------
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> mesh_warnings(V, np.array([[0, 1, 2], [2, 0, 1]]))
+    ['1 duplicate faces (same vertices as another face)']
+    """
+    out = []
+    collapsed = len(F) - len(solvable_faces(F))
+    if collapsed:
+        out.append(f"{collapsed} faces repeat a vertex; left out of the solve")
+    F = solvable_faces(F)
+    keys = np.sort(F, axis=1)
+    duplicates = len(F) - len(np.unique(keys, axis=0))
+    if duplicates:
+        out.append(f"{duplicates} duplicate faces (same vertices as another face)")
+    scale = float(np.ptp(V, axis=0).max()) ** 2 if len(V) else 0.0
+    area2 = igl.doublearea(V, F)
+    zero = ~(area2 > 1e-14 * scale)
+    if zero.any():
+        out.append(f"{int(zero.sum())} zero-area faces; their edges get no weight from them")
+    with np.errstate(invalid="ignore"):
+        angles = np.degrees(igl.internal_angles(V, F[~zero])) if (~zero).any() else np.zeros((0, 3))
+    needles = int((angles.min(axis=1, initial=180) < NEEDLE_DEGREES).sum()) if len(angles) else 0
+    if needles:
+        out.append(f"{needles} needle faces (an angle under {NEEDLE_DEGREES:g} degree); "
+                   "cotangents are capped at 1000 so no edge weight can swamp the others")
+    out.extend(_manifold_warnings(np.unique(keys, axis=0), len(V)))  # duplicates said above
+    return out
+
+
+def _manifold_warnings(F, n):
+    out = []
+    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    if (counts > 2).any():
+        out.append(f"{int((counts > 2).sum())} non-manifold edges (more than two faces); solved, "
+                   "the operators are defined there")
+    referenced = np.zeros(n, dtype=bool)
+    referenced[F.ravel()] = True
+    manifold = np.asarray(igl.is_vertex_manifold(F), dtype=bool).ravel()
+    bad = int((referenced[:manifold.size] & ~manifold).sum())
+    if bad:
+        out.append(f"{bad} non-manifold vertices (faces around them form several fans); solved")
+    return out
