@@ -42,17 +42,20 @@ def tube(tmp_path):
 def test_awkward_triangles_are_solved_finitely_and_counted(tmp_path, tube):
     V, F = tube
     n = len(V)
-    extra_v = np.array([[3.0, 0, 3], [4.0, 0, 3], [3.5, 1e-7, 3], [3.0, 1, 3], [4.0, 1, 3]])
+    extra_v = np.array([[3.0, 0, 3], [4.0, 0, 3], [3.5, 1e-7, 3], [3.0, 1, 3], [4.0, 1, 3],
+                        [3.5, 0, 3], [5.0, 0, 3], [5.0, 1, 3], [6.0, 0, 3], [6.0, 1, 3]])
     V2 = np.vstack([V, extra_v])
     needle = [n, n + 1, n + 2]
     fan = [[n, n + 1, n + 3], [n, n + 1, n + 4]]  # edge (n, n+1) now has three faces
-    F2 = np.vstack([F, F[:2], needle, fan, [[n, n, n + 1]]])
+    flat = [n, n + 5, n + 1]  # three distinct collinear points
+    bowtie = [[n + 6, n + 7, n + 8], [n + 6, n + 8, n + 9], [n + 6, n + 1, n + 4]]
+    F2 = np.vstack([F, F[:2], needle, fan, [[n, n, n + 1]], flat, bowtie])
     write_obj(tmp_path / "m.obj", V2, F2)
     groups = {"base": BASE, "tip": TIP, "extra": {"indices": [n], "fixed": True}}
     r = run(tmp_path / "m.obj", handles(tmp_path, groups), "-o", tmp_path / "o.obj")
     assert r.exit_code in (0, 3), r.output
     for text in ("2 duplicate faces", "1 needle faces", "1 non-manifold edges",
-                 "1 faces repeat a vertex"):
+                 "1 faces repeat a vertex", "1 zero-area faces", "non-manifold vertices"):
         assert text in r.stderr
     out = read_mesh(str(tmp_path / "o.obj")).vertices
     assert np.isfinite(out).all() and len(out) == len(V2)
@@ -147,3 +150,13 @@ def test_a_killed_run_leaves_the_old_output_whole(tmp_path, sig, code):
     assert "no output written" in err and "Traceback" not in err
     assert out.read_text() == "old result\n" and not log.exists()
     assert [p.name for p in tmp_path.iterdir()] == ["out.obj"]
+
+
+def test_debug_shows_the_traceback_and_the_default_does_not(tmp_path):
+    missing = tmp_path / "missing.obj"
+    quiet = CliRunner().invoke(main, ["deform", str(missing), str(handles(tmp_path)), "-o",
+                                      str(tmp_path / "o.obj")])
+    loud = CliRunner().invoke(main, ["--debug", "deform", str(missing), str(handles(tmp_path)),
+                                     "-o", str(tmp_path / "o.obj")])
+    assert quiet.exit_code == loud.exit_code == 4
+    assert "Traceback" not in quiet.stderr and "Traceback" in loud.stderr
