@@ -39,6 +39,15 @@ class Problem:
     ids: np.ndarray
     targets: np.ndarray
     area: float = None
+    sub: object = None
+
+    def targets_for(self, constraint_targets):
+        """Solve targets for a new set of constraint targets (same constrained vertices)."""
+        if self.sub is None:
+            return constraint_targets
+        out = self.targets.copy()
+        out[self.sub.slots] = constraint_targets[self.sub.which]
+        return out
 
 
 def problem(mesh, constraints):
@@ -50,7 +59,21 @@ def problem(mesh, constraints):
         return Problem(np.arange(len(V)), V, F, constraints.ids, constraints.targets)
     sub = restrict(V, F, constraints.ids, constraints.targets, constraints.region)
     return Problem(sub.vertices, V[sub.vertices], sub.faces, sub.constrained, sub.targets,
-                   mesh_area(V, F))
+                   mesh_area(V, F), sub)
+
+
+def build_deformer(p, opts):
+    """The :class:`Deformer` of a :class:`Problem` with resolved settings ``opts``."""
+    return Deformer(p.V, p.F, p.ids, alpha=opts["alpha"], feedback=opts["feedback"],
+                    weights=opts["weights"], area=p.area, method=opts["method"],
+                    sweeps=opts["sweeps"])
+
+
+def scatter(mesh, p, positions):
+    """Full-mesh positions from a problem's solved positions."""
+    out = mesh.vertices.copy()
+    out[p.vertices] = positions
+    return out
 
 
 def deform_mesh(mesh, constraints, callback=None, **overrides):
@@ -71,13 +94,10 @@ def deform_mesh(mesh, constraints, callback=None, **overrides):
     """
     opts = settings(constraints.solver, overrides)
     p = problem(mesh, constraints)
-    deformer = Deformer(p.V, p.F, p.ids, alpha=opts["alpha"], feedback=opts["feedback"],
-                        weights=opts["weights"], area=p.area, method=opts["method"],
-                        sweeps=opts["sweeps"])
+    deformer = build_deformer(p, opts)
     sub_result = deformer.solve(p.targets, max_iter=opts["max_iter"], tol=opts["tol"],
                                 callback=callback)
-    positions = mesh.vertices.copy()
-    positions[p.vertices] = sub_result.positions
+    positions = scatter(mesh, p, sub_result.positions)
     rotors = np.tile(IDENTITY, (len(positions), 1))
     rotors[p.vertices] = sub_result.rotors
     result = DeformResult(positions, rotors, sub_result.log, sub_result.converged,

@@ -14,12 +14,16 @@ class Submesh:
     faces : (f, 3) int array, triangles in submesh ids
     constrained : (k,) int array, submesh ids whose positions are prescribed
     targets : (k, 3) float array
+    slots, which : int arrays, ``targets[slots] = constraint_targets[which]``; the other
+        constrained submesh vertices stay at rest
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     constrained: np.ndarray
     targets: np.ndarray
+    slots: np.ndarray
+    which: np.ndarray
 
 
 def restrict(V, F, ids, targets, region):
@@ -51,5 +55,7 @@ def restrict(V, F, ids, targets, region):
     in_sub = local[ids] >= 0
     full_targets[local[ids[in_sub]]] = targets[in_sub]
     fixed = np.flatnonzero(~movable[verts])
+    which = np.flatnonzero(in_sub)
+    slots = np.searchsorted(fixed, local[ids[which]])
     return Submesh(vertices=verts, faces=local[faces], constrained=fixed,
-                   targets=full_targets[fixed])
+                   targets=full_targets[fixed], slots=slots, which=which)

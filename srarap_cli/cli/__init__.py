@@ -1,6 +1,7 @@
 """The ``srarap`` command group; each subcommand lives in its own module."""
 import click
 
+from .animate import animate
 from .bench import bench
 from .deform import deform
 
@@ -14,3 +15,4 @@ def main(debug):
 
 main.add_command(deform)
 main.add_command(bench)
+main.add_command(animate)

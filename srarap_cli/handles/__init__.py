@@ -16,11 +16,13 @@ from ..local_step import METHODS
 from ..operators import WEIGHT_KINDS
 from .fields import Context
 from .formats import read_def, read_sel
+from .keys import parse_track
 from .selectors import SELECTOR_KEYS, select
 from .transforms import ACTION_KEYS, targets
 
 SOLVER_KEYS = ("alpha", "feedback", "max_iter", "tol", "weights", "method", "sweeps")
 TOP_KEYS = ("groups", "region", "solver")
+ANIMATION_KEYS = ("keyframes", "easing")
 
 
 @dataclass
@@ -35,6 +37,8 @@ class Constraints:
     region : (r,) int array or None, vertices allowed to move (region of interest);
         everything else stays at rest
     solver : dict, solver settings given in the file (keys from SOLVER_KEYS)
+    tracks : list of (slots, rest, Track): keyframed groups, ``slots`` indexing ``ids``;
+        ``targets`` holds their pose at frame 0
     """
 
     ids: np.ndarray
@@ -42,15 +46,29 @@ class Constraints:
     groups: dict = field(default_factory=dict)
     region: np.ndarray = None
     solver: dict = field(default_factory=dict)
+    tracks: list = field(default_factory=list)
+
+    @property
+    def last_key_frame(self):
+        """Frame of the latest keyframe (0 without keyframes)."""
+        return max((float(t.frames[-1]) for _, _, t in self.tracks), default=0.0)
+
+    def targets_at(self, frame):
+        """Targets (k, 3) at ``frame``: keyframed groups moved, the others as they are."""
+        out = self.targets.copy()
+        for slots, rest, track in self.tracks:
+            out[slots] = track.apply(rest, frame)
+        return out
 
 
-def load_handles(path, V):
+def load_handles(path, V, fps=None):
     """Read and validate a handle file against rest positions ``V`` (n, 3).
 
     Parameters
     ----------
     path : str, ``.yaml``/``.yml``, ``.json`` or ``.sel``
     V : (n, 3) float array
+    fps : float, optional; frames per second, for keyframes given by ``time``
 
     Returns
     -------
@@ -61,7 +79,8 @@ def load_handles(path, V):
         raise InputError(f"{path}: is a folder, not a handle file")
     if path.lower().endswith(".sel"):
         return _from_sel(path, V)
-    return parse_handles(_load_document(path), V, path, os.path.dirname(os.path.abspath(path)))
+    return parse_handles(_load_document(path), V, path, os.path.dirname(os.path.abspath(path)),
+                         fps)
 
 
 def _load_document(path):
@@ -80,28 +99,49 @@ def _load_document(path):
         raise InputError(f"{path}: not valid {ext[1:].upper()}{where}: {first}") from None
 
 
-def parse_handles(doc, V, path="<handles>", base="."):
+def parse_handles(doc, V, path="<handles>", base=".", fps=None):
     """Validate an already-loaded handle document (dict) against ``V``; see :func:`load_handles`."""
     ctx = Context(path)
     doc = ctx.mapping(doc, "the handle file", TOP_KEYS)
     groups = doc.get("groups")
     if not isinstance(groups, dict) or not groups:
         raise ctx.error("'groups' must map at least one group name to its selection and action")
-    names, ids, tgts = [], [], []
+    names, ids, tgts, tracks = [], [], [], {}
     for name, spec in groups.items():
         gctx = ctx.at(f"group {name!r}")
-        spec = gctx.mapping(spec, "the group", SELECTOR_KEYS + ACTION_KEYS)
+        spec = gctx.mapping(spec, "the group", SELECTOR_KEYS + ACTION_KEYS + ANIMATION_KEYS)
         sel = select(gctx, spec, V, base)
         names.append(str(name))
         ids.append(sel)
-        tgts.append(targets(gctx, spec, V[sel], base))
+        if "keyframes" in spec:
+            tracks[str(name)] = parse_track(gctx, spec, V[sel], fps)
+            tgts.append(tracks[str(name)].apply(V[sel], 0.0))
+        else:
+            if "easing" in spec:
+                raise gctx.error("easing only applies together with keyframes")
+            tgts.append(targets(gctx, spec, V[sel], base))
     region = None
     if "region" in doc:
         rctx = ctx.at("region")
         region = select(rctx, rctx.mapping(doc["region"], "region", SELECTOR_KEYS), V, base)
     merged_ids, merged = _merge(ctx, names, ids, tgts, V)
     return Constraints(ids=merged_ids, targets=merged, groups=dict(zip(names, ids)),
-                       region=region, solver=_solver(ctx.at("solver"), doc.get("solver", {})))
+                       region=region, solver=_solver(ctx.at("solver"), doc.get("solver", {})),
+                       tracks=_tracks(ctx, tracks, dict(zip(names, ids)), merged_ids, V))
+
+
+def _tracks(ctx, tracks, groups, merged_ids, V):
+    """(slots, rest, track) per keyframed group; its vertices may belong to no other group."""
+    out = []
+    for name, track in tracks.items():
+        mine = groups[name]
+        for other, theirs in groups.items():
+            shared = np.intersect1d(mine, theirs) if other != name else ()
+            if len(shared):
+                raise ctx.error(f"vertex {shared[0]} is in keyframed group {name!r} and in "
+                                f"group {other!r}")
+        out.append((np.searchsorted(merged_ids, mine), V[mine], track))
+    return out
 
 
 def _merge(ctx, names, ids, tgts, V):

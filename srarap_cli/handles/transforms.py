@@ -9,7 +9,8 @@ from .formats import read_def
 ACTION_KEYS = ("fixed", "translate", "rotate", "pivot", "matrix")
 
 
-def _rotation(ctx, spec):
+def rotation_matrix(ctx, spec):
+    """3x3 matrix of a ``rotate`` entry (axis and angle in degrees, or a quaternion)."""
     spec = ctx.mapping(spec, "rotate", ("axis", "angle", "quaternion"))
     if "quaternion" in spec:
         if "axis" in spec or "angle" in spec:
@@ -64,7 +65,7 @@ def targets(ctx, spec, rest, base):
     if "rotate" in spec:
         pivot = (ctx.vector(spec["pivot"], "pivot", 3) if "pivot" in spec
                  else rest.mean(axis=0))
-        out = (rest - pivot) @ _rotation(ctx, spec["rotate"]).T + pivot
+        out = (rest - pivot) @ rotation_matrix(ctx, spec["rotate"]).T + pivot
     if "translate" in spec:
         out = out + ctx.vector(spec["translate"], "translate", 3)
     return out
