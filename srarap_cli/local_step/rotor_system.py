@@ -4,8 +4,9 @@ Row ``i`` (free vertex) reads ``(sigma_i M_i + tau_i I) R_i - sum_j omega_ij R_j
 with symmetric edge weights ``omega``; columns of constrained vertices move to the right-hand
 side. Rows are strictly block diagonally dominant (``tau_i > sum_j omega_ij``, ``M_i`` PSD), so
 the matrix is symmetric positive definite, solved by conjugate gradients to relative residual
-1e-10, warm-started from the previous raw solution; a direct factorization takes over should
-CG stall.
+1e-10, started from the previous rotors (and from nothing else, so a solve depends only on its
+inputs: resumed animations reproduce uninterrupted ones bit for bit); a direct factorization
+takes over should CG stall.
 
 Preconditioner: ``alpha A`` grows with the mesh while ``M_i`` does not, so the system is mostly
 the graph coupling ``omega`` (a shifted Laplacian, poorly served by block-Jacobi: 50 to 300 CG
@@ -42,7 +43,6 @@ class RotorSystem:
         self.fixed = np.flatnonzero(constrained)
         self.sigma, self.tau, self.phi = sigma, tau, phi
         self.cg_iterations = 0
-        self._last = None
         W = sp.csr_matrix((omega, (graph.I, graph.J)), shape=(graph.n,) * 2)
         self._fixed_rows = W[self.fixed]
         self._free_to_fixed = W[self.free][:, self.fixed].tocsr()
@@ -91,12 +91,8 @@ class RotorSystem:
                                       R_prev[self.fixed])
         if self.free.size:
             A, b = self.free_system(D, R_prev, R[self.fixed])
-            x0 = (self._last[0] if self._last is not None
-                  and np.array_equal(self._last[1], R_prev[self.free])
-                  else R_prev[self.free].ravel())  # raw solutions are not unit length
-            sol = self._solve(A, b, x0)
+            sol = self._solve(A, b, R_prev[self.free].ravel())
             R[self.free] = normalize(sol.reshape(-1, 4), R_prev[self.free])
-            self._last = (sol, R[self.free])
         return R
 
     def _solve(self, A, b, x0):
