@@ -138,3 +138,28 @@ def test_time_keys_use_the_frame_rate_and_set_the_frame_count(tmp_path):
 def test_output_pattern_needs_a_frame_field(tmp_path):
     r = CliRunner().invoke(main, ["animate", BAR, TWIST, "-o", str(tmp_path / "frame.obj")])
     assert r.exit_code == 2 and "no field for the frame number" in r.output
+
+
+def test_progress_shows_on_a_terminal_and_stays_quiet_in_a_pipe(tmp_path):
+    import pty
+    import select
+
+    cmd = [sys.executable, "-m", "srarap_cli", "animate", BAR, TWIST, "-o",
+           str(tmp_path / "f{:02d}.obj"), "--frames", "5"]
+    master, slave = pty.openpty()
+    subprocess.run(cmd, stderr=slave, stdout=subprocess.DEVNULL, check=True, timeout=120)
+    os.close(slave)
+    seen = b""
+    while select.select([master], [], [], 0.5)[0]:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:  # the other end is closed once everything is read
+            break
+        if not chunk:
+            break
+        seen += chunk
+    os.close(master)
+    text = seen.decode(errors="replace")
+    assert "frame 5/5" in text and "frames/s" in text and "ETA" in text
+    piped = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    assert "frame 5/5" not in piped.stderr and "srarap animate: 5 frames" in piped.stderr
