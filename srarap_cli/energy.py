@@ -67,4 +67,4 @@ def bending_energy(graph, R, alpha, area):
     sq = np.einsum("ij,ij->i", R, R)
     # |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b ; the min takes the sign that agrees
     dist = np.take(sq, graph.I) + np.take(sq, graph.J) - 2.0 * np.abs(dots)
-    return float(alpha * area * (np.maximum(dist, 0.0) @ graph.inv_degree_of_edge))
+    return float(alpha * area * (np.maximum(dist, 0.0) @ graph.edge_inv_degree))

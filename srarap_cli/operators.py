@@ -33,6 +33,8 @@ class CellGraph:
         Ones at ``(I[e], e)``: sums per-edge values into their source vertex.
     degenerate : int
         Triangle angles whose cotangent was not finite (zero-area faces); they count as 0.
+    edge_inv_degree : (m,) float array
+        ``1 / deg_i`` for each directed edge ``i -> j`` (bending weights of the energy).
     """
 
     I: np.ndarray
@@ -43,17 +45,11 @@ class CellGraph:
     area: float
     incidence: sp.csr_matrix
     degenerate: int = 0
+    edge_inv_degree: np.ndarray = None
 
     @property
     def n(self):
         return self.degree.shape[0]
-
-    @property
-    def inv_degree_of_edge(self):
-        """``1 / deg_i`` for each directed edge ``i -> j``: (m,)."""
-        if not hasattr(self, "_inv_degree_of_edge"):
-            object.__setattr__(self, "_inv_degree_of_edge", 1.0 / self.degree[self.I])
-        return self._inv_degree_of_edge
 
     def cell_sum(self, values):
         """Sum per-edge ``values`` of shape (m, ...) into their source vertex: (n, ...)."""
@@ -112,4 +108,5 @@ def cell_graph(V, F, weights="cotan-clamped"):
     incidence = sp.csr_matrix((np.ones(I.size), (I, np.arange(I.size))), shape=(n, I.size))
     return CellGraph(I=I, J=W.indices.astype(np.int64), c=W.data.copy(),
                      degree=np.diff(W.indptr), laplacian=K, area=area, incidence=incidence,
-                     degenerate=int((~finite).sum()))
+                     degenerate=int((~finite).sum()),
+                     edge_inv_degree=1.0 / np.diff(W.indptr)[I])

@@ -2,10 +2,8 @@
 import io
 import json
 import math
-import os
 
 from .deformer import LOG_FIELDS
-from .mesh_io import atomic_write
 
 LOG_FORMATS = (".csv", ".jsonl", ".ndjson")
 
@@ -31,8 +29,3 @@ def _cell(value):
 
 def _json(value):
     return None if isinstance(value, float) and math.isnan(value) else value
-
-
-def write_log(path, rows):
-    """Write the log atomically; the format follows the extension (.csv, .jsonl, .ndjson)."""
-    atomic_write(path, format_log(rows, os.path.splitext(str(path))[1].lower()).encode("utf-8"))
