@@ -6,5 +6,6 @@ NOT_CONVERGED = 3
 INVALID_INPUT = 4
 NUMERICAL_FAILURE = 5
 OUTPUT_ERROR = 6
+BEYOND_TOLERANCE = 7  # srarap compare: the meshes differ by more than --tol
 INTERRUPTED = 130  # SIGINT (Ctrl-C)
 TERMINATED = 143  # SIGTERM

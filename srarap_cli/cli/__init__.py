@@ -3,6 +3,7 @@ import click
 
 from .animate import animate
 from .bench import bench
+from .compare import compare
 from .deform import deform
 
 
@@ -16,3 +17,4 @@ def main(debug):
 main.add_command(deform)
 main.add_command(bench)
 main.add_command(animate)
+main.add_command(compare)
