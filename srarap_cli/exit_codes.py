@@ -7,5 +7,6 @@ INVALID_INPUT = 4
 NUMERICAL_FAILURE = 5
 OUTPUT_ERROR = 6
 BEYOND_TOLERANCE = 7  # srarap compare: the meshes differ by more than --tol
+BATCH_FAILED = 8  # srarap batch: a job failed or regressed
 INTERRUPTED = 130  # SIGINT (Ctrl-C)
 TERMINATED = 143  # SIGTERM

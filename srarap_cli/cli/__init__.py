@@ -2,6 +2,7 @@
 import click
 
 from .animate import animate
+from .batch import batch
 from .bench import bench
 from .compare import compare
 from .deform import deform
@@ -18,3 +19,4 @@ main.add_command(deform)
 main.add_command(bench)
 main.add_command(animate)
 main.add_command(compare)
+main.add_command(batch)

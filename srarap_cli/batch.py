@@ -1,0 +1,156 @@
+"""Many deformations from one manifest: up-to-date checks, parallel workers, a summary.
+
+A manifest (YAML or JSON) lists jobs; paths are relative to the manifest::
+
+    defaults: {method: sr-linear-sym, tol: 1.0e-6}      # solver settings for every job
+    jobs:
+      - name: bar-twist
+        mesh: ../sample_meshes/bar.obj
+        handles: ../configs/bar-twist.yaml
+        output: bar-twist.obj                           # relative to the output folder
+        settings: {max_iter: 500}                       # this job only
+        expect: {golden: golden/bar-twist.obj, tol: 1.0e-9, relative: true}
+
+A job is up to date when its output exists and the sidecar ``<output>.srarap.json`` records
+the same fingerprint (content of mesh and handle file, settings, srarap version).
+"""
+import hashlib
+import json
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from importlib import metadata
+
+import yaml
+
+from .compare import compare_meshes
+from .errors import InputError
+from .handles import SOLVER_KEYS, load_handles
+from .mesh_io import format_mesh, read_mesh
+from .mesh_io.commit import commit_files
+from .pipeline import deform_mesh
+
+JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
+SUMMARY_FIELDS = ("job", "status", "iterations", "energy", "seconds", "compare_max", "message")
+
+
+def load_manifest(path):
+    """Jobs of a manifest, with absolute paths and merged settings (list of dict)."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh) if path.lower().endswith(".json") else yaml.safe_load(fh)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
+    except (ValueError, yaml.YAMLError) as exc:
+        raise InputError(f"{path}: not a valid manifest ({str(exc).splitlines()[0]})") from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("jobs"), list) or not doc["jobs"]:
+        raise InputError(f"{path}: a manifest needs a non-empty 'jobs' list")
+    base = os.path.dirname(os.path.abspath(path))
+    defaults = _settings(path, "defaults", doc.get("defaults", {}))
+    jobs, names = [], set()
+    for k, job in enumerate(doc["jobs"]):
+        where = f"{path}: job {k}"
+        if not isinstance(job, dict) or not {"mesh", "handles", "output"} <= set(job):
+            raise InputError(f"{where}: needs mesh, handles and output")
+        unknown = sorted(set(job) - set(JOB_KEYS))
+        if unknown:
+            raise InputError(f"{where}: unknown key {unknown[0]!r}")
+        name = str(job.get("name", os.path.splitext(str(job["output"]))[0]))
+        if name in names:
+            raise InputError(f"{where}: job name {name!r} used twice")
+        names.add(name)
+        expect = job.get("expect")
+        if expect is not None:
+            if not isinstance(expect, dict) or "golden" not in expect:
+                raise InputError(f"{where}: expect needs a golden mesh")
+            expect = {"golden": os.path.join(base, str(expect["golden"])),
+                      "tol": float(expect.get("tol", 0.0)),
+                      "relative": bool(expect.get("relative", False))}
+        jobs.append({"name": name, "mesh": os.path.join(base, str(job["mesh"])),
+                     "handles": os.path.join(base, str(job["handles"])),
+                     "output": str(job["output"]), "expect": expect,
+                     "settings": {**defaults, **_settings(where, "settings",
+                                                          job.get("settings", {}))}})
+    return jobs
+
+
+def _settings(where, key, spec):
+    if not isinstance(spec, dict) or set(spec) - set(SOLVER_KEYS):
+        raise InputError(f"{where}: {key} must be a mapping of {', '.join(SOLVER_KEYS)}")
+    return dict(spec)
+
+
+def fingerprint(job):
+    """Content hash of everything that decides a job's output."""
+    h = hashlib.sha256()
+    for path in (job["mesh"], job["handles"]):
+        try:
+            with open(path, "rb") as fh:
+                h.update(hashlib.sha256(fh.read()).digest())
+        except OSError:
+            h.update(b"missing:" + path.encode())
+    h.update(json.dumps([job["settings"], job["output"], metadata.version("srarap-cli")],
+                        sort_keys=True).encode())
+    return h.hexdigest()
+
+
+def run_job(job, out_dir):
+    """Run one job; never raises. Returns its summary row (dict with SUMMARY_FIELDS)."""
+    start = time.perf_counter()
+    row = {"job": job["name"], "status": "failed", "iterations": None, "energy": None,
+           "seconds": None, "compare_max": None, "message": ""}
+    out = os.path.join(out_dir, job["output"])
+    sidecar = out + ".srarap.json"
+    key = fingerprint(job)
+    try:
+        if os.path.exists(out) and _recorded(sidecar) == key:
+            row.update(status="up-to-date", **_recorded_row(sidecar))
+        else:
+            mesh = read_mesh(job["mesh"])
+            constraints = load_handles(job["handles"], mesh.vertices)
+            deformed, result, _ = deform_mesh(mesh, constraints, **job["settings"])
+            data, _ = format_mesh(deformed, os.path.splitext(out)[1].lower())
+            row.update(status="ok" if result.converged else "not-converged",
+                       iterations=result.iterations, energy=result.energy)
+            os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+            commit_files([(out, data), (sidecar, json.dumps(
+                {"fingerprint": key, "iterations": result.iterations,
+                 "energy": result.energy}).encode())])
+        if job["expect"] is not None:
+            _check_golden(row, job["expect"], out)
+    except Exception as exc:  # noqa: BLE001 -- a failing job is reported, never fatal
+        row.update(status="failed", message=str(exc).splitlines()[0] if str(exc) else
+                   type(exc).__name__)
+    row["seconds"] = time.perf_counter() - start
+    return row
+
+
+def _check_golden(row, expect, out):
+    figures = compare_meshes(read_mesh(expect["golden"]), read_mesh(out))
+    scale = figures["diagonal"] if expect["relative"] and figures["diagonal"] > 0 else 1.0
+    row["compare_max"] = figures["max"] / scale
+    if row["compare_max"] > expect["tol"]:
+        row["status"] = "regressed"
+        row["message"] = f"max distance {row['compare_max']:.3g} > tol {expect['tol']:g}"
+
+
+def _recorded(sidecar):
+    try:
+        with open(sidecar) as fh:
+            return json.load(fh).get("fingerprint")
+    except (OSError, ValueError):
+        return None
+
+
+def _recorded_row(sidecar):
+    with open(sidecar) as fh:
+        rec = json.load(fh)
+    return {"iterations": rec.get("iterations"), "energy": rec.get("energy")}
+
+
+def run_batch(jobs, out_dir, workers=1):
+    """Run jobs (in worker processes when ``workers > 1``); rows in manifest order."""
+    if workers <= 1:
+        return [run_job(job, out_dir) for job in jobs]
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(run_job, jobs, [out_dir] * len(jobs)))

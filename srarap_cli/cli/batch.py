@@ -1,0 +1,56 @@
+"""``srarap batch``: run a manifest of deformations, skipping what is up to date."""
+import csv
+import io
+import json
+import os
+
+import click
+
+from .. import exit_codes
+from ..batch import SUMMARY_FIELDS, load_manifest, run_batch
+from ..errors import OutputError
+from ..mesh_io.commit import commit_files
+from .common import guarded
+
+
+@click.command("batch")
+@click.argument("manifest")
+@click.option("--workers", type=click.IntRange(min=1), default=1, show_default=True,
+              help="Worker processes.")
+@click.option("-o", "--output", "out", default=".", show_default=True,
+              help="Folder for the jobs' outputs and summary.csv / summary.json.")
+@click.option("-q", "--quiet", is_flag=True, help="No summary table.")
+@guarded
+def batch(manifest, workers, out, quiet):
+    """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
+
+    Exit code 0 when every job is ok or up to date (or only not converged), 8 when any job
+    failed or regressed against its golden mesh.
+    """
+    jobs = load_manifest(manifest)
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
+    rows = run_batch(jobs, out, workers)
+    commit_files([(os.path.join(out, "summary.csv"), _csv(rows).encode()),
+                  (os.path.join(out, "summary.json"), (json.dumps(rows, indent=2) + "\n").encode())])
+    counts = {s: sum(r["status"] == s for r in rows) for s in
+              ("ok", "up-to-date", "not-converged", "regressed", "failed")}
+    if not quiet:
+        for r in rows:
+            extra = f"  {r['message']}" if r["message"] else ""
+            click.echo(f"{r['job']:24} {r['status']:13} {r['seconds']:8.2f} s{extra}", err=True)
+        summary = ", ".join(f"{v} {k}" for k, v in counts.items() if v)
+        note = " (nothing to solve: all up to date)" if counts["up-to-date"] == len(rows) else ""
+        click.echo(f"srarap batch: {len(rows)} jobs: {summary}{note}", err=True)
+    if counts["failed"] or counts["regressed"]:
+        raise SystemExit(exit_codes.BATCH_FAILED)
+
+
+def _csv(rows):
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=SUMMARY_FIELDS, lineterminator="\n")
+    w.writeheader()
+    w.writerows(rows)
+    return buf.getvalue()

@@ -1,0 +1,74 @@
+"""``srarap batch``: failures isolated, up-to-date jobs skipped, goldens checked."""
+import csv
+import os
+
+import yaml
+from click.testing import CliRunner
+from helpers import ROOT
+
+from srarap_cli.cli import main
+from srarap_cli.mesh_io import read_mesh, write_mesh
+
+BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
+BEND = os.path.join(ROOT, "configs", "bar-bend.yaml")
+TWIST = os.path.join(ROOT, "configs", "bar-twist.yaml")
+
+
+def manifest(tmp_path, jobs, defaults=None):
+    path = tmp_path / "jobs.yaml"
+    path.write_text(yaml.safe_dump({"defaults": defaults or {"max_iter": 300}, "jobs": jobs}))
+    return path
+
+
+def run(path, out, *extra):
+    r = CliRunner().invoke(main, ["batch", str(path), "-o", str(out), *extra])
+    with open(out / "summary.csv") as fh:
+        return r, {row["job"]: row for row in csv.DictReader(fh)}
+
+
+def test_a_broken_job_is_reported_and_the_rest_run_then_nothing_reruns(tmp_path):
+    jobs = [{"name": "twist", "mesh": BAR, "handles": TWIST, "output": "twist.obj"},
+            {"name": "broken", "mesh": str(tmp_path / "missing.obj"), "handles": BEND,
+             "output": "broken.obj"},
+            {"name": "bend", "mesh": BAR, "handles": BEND, "output": "sub/bend.ply"}]
+    out = tmp_path / "out"
+    r, rows = run(manifest(tmp_path, jobs), out, "--workers", "2")
+    assert r.exit_code == 8
+    assert [rows[j]["status"] for j in ("twist", "broken", "bend")] == ["ok", "failed", "ok"]
+    assert "missing.obj" in rows["broken"]["message"]
+    first = (out / "twist.obj").read_bytes()
+    assert len(read_mesh(str(out / "sub" / "bend.ply")).vertices) == len(read_mesh(BAR).vertices)
+    r, rows = run(manifest(tmp_path, jobs), out, "--workers", "2")
+    assert [rows[j]["status"] for j in ("twist", "bend")] == ["up-to-date", "up-to-date"]
+    assert rows["twist"]["iterations"] and (out / "twist.obj").read_bytes() == first
+    r, rows = run(manifest(tmp_path, jobs[:1]), out)
+    assert r.exit_code == 0 and "nothing to solve: all up to date" in r.stderr
+    r, rows = run(manifest(tmp_path, jobs[:1], {"max_iter": 301}), out)
+    assert rows["twist"]["status"] == "ok"  # settings changed: solved again
+
+
+def test_parallel_and_sequential_runs_write_the_same_bytes(tmp_path):
+    jobs = [{"name": n, "mesh": BAR, "handles": h, "output": f"{n}.obj"}
+            for n, h in (("twist", TWIST), ("bend", BEND))]
+    run(manifest(tmp_path, jobs), tmp_path / "seq")
+    run(manifest(tmp_path, jobs), tmp_path / "par", "--workers", "2")
+    for n in ("twist", "bend"):
+        assert (tmp_path / "seq" / f"{n}.obj").read_bytes() == (tmp_path / "par" / f"{n}.obj").read_bytes()
+
+
+def test_a_result_away_from_its_golden_is_a_regression(tmp_path):
+    golden = tmp_path / "golden.obj"
+    m = read_mesh(BAR)
+    write_mesh(str(golden), m.with_vertices(m.vertices + [0.0, 0.0, 0.01]))
+    jobs = [{"name": "bend", "mesh": BAR, "handles": BEND, "output": "bend.obj",
+             "expect": {"golden": str(golden), "tol": 1e-3, "relative": True}}]
+    r, rows = run(manifest(tmp_path, jobs), tmp_path / "out")
+    assert r.exit_code == 8 and rows["bend"]["status"] == "regressed"
+    assert float(rows["bend"]["compare_max"]) > 1e-3
+
+
+def test_bad_manifest_is_invalid_input(tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_text(yaml.safe_dump({"jobs": [{"mesh": BAR, "output": "x.obj"}]}))
+    r = CliRunner().invoke(main, ["batch", str(path), "-o", str(tmp_path)])
+    assert r.exit_code == 4 and "needs mesh, handles and output" in r.stderr
