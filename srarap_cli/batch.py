@@ -148,9 +148,30 @@ def _recorded_row(sidecar):
     return {"iterations": rec.get("iterations"), "energy": rec.get("energy")}
 
 
-def run_batch(jobs, out_dir, workers=1):
-    """Run jobs (in worker processes when ``workers > 1``); rows in manifest order."""
+def run_batch(jobs, out_dir, workers=1, scheduler=None):
+    """Run jobs: on a Dask cluster at ``scheduler``, else in ``workers`` local processes
+    (in this process when 1). Rows come back in manifest order.
+
+    The Dask workers must see the same files as this process (a shared file system).
+    """
+    if scheduler is not None:
+        return _run_on_dask(jobs, out_dir, scheduler)
     if workers <= 1:
         return [run_job(job, out_dir) for job in jobs]
     with ProcessPoolExecutor(max_workers=workers) as pool:
         return list(pool.map(run_job, jobs, [out_dir] * len(jobs)))
+
+
+def _run_on_dask(jobs, out_dir, scheduler):
+    try:
+        from distributed import Client
+    except ImportError:
+        raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
+    out_dir = os.path.abspath(out_dir)
+    try:
+        client = Client(scheduler, timeout=30)
+    except (OSError, TimeoutError) as exc:
+        raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+    with client:
+        futures = client.map(run_job, jobs, [out_dir] * len(jobs), pure=False)
+        return client.gather(futures)

@@ -72,3 +72,25 @@ def test_bad_manifest_is_invalid_input(tmp_path):
     path.write_text(yaml.safe_dump({"jobs": [{"mesh": BAR, "output": "x.obj"}]}))
     r = CliRunner().invoke(main, ["batch", str(path), "-o", str(tmp_path)])
     assert r.exit_code == 4 and "needs mesh, handles and output" in r.stderr
+
+
+def test_a_dask_cluster_gives_the_same_results_as_local_workers(tmp_path):
+    from distributed import LocalCluster
+
+    jobs = [{"name": n, "mesh": BAR, "handles": h, "output": f"{n}.obj"}
+            for n, h in (("twist", TWIST), ("bend", BEND))]
+    jobs.append({"name": "broken", "mesh": str(tmp_path / "missing.obj"), "handles": BEND,
+                 "output": "broken.obj"})
+    path = manifest(tmp_path, jobs)
+    local, local_rows = run(path, tmp_path / "local", "--workers", "2")
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster:
+        remote, remote_rows = run(path, tmp_path / "dask", "--scheduler",
+                                  cluster.scheduler_address)
+    assert local.exit_code == remote.exit_code == 8
+    assert {k: r["status"] for k, r in remote_rows.items()} == \
+        {k: r["status"] for k, r in local_rows.items()}
+    for n in ("twist", "bend"):
+        assert (tmp_path / "dask" / f"{n}.obj").read_bytes() == \
+            (tmp_path / "local" / f"{n}.obj").read_bytes()
+        assert remote_rows[n]["iterations"] == local_rows[n]["iterations"]

@@ -17,11 +17,13 @@ from .common import guarded
 @click.argument("manifest")
 @click.option("--workers", type=click.IntRange(min=1), default=1, show_default=True,
               help="Worker processes.")
+@click.option("--scheduler", help="Run the jobs on the Dask cluster at this address "
+              "(pip install 'srarap-cli[dask]'); its workers must share this file system.")
 @click.option("-o", "--output", "out", default=".", show_default=True,
               help="Folder for the jobs' outputs and summary.csv / summary.json.")
 @click.option("-q", "--quiet", is_flag=True, help="No summary table.")
 @guarded
-def batch(manifest, workers, out, quiet):
+def batch(manifest, workers, scheduler, out, quiet):
     """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
 
     Exit code 0 when every job is ok or up to date (or only not converged), 8 when any job
@@ -32,7 +34,7 @@ def batch(manifest, workers, out, quiet):
         os.makedirs(out, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
-    rows = run_batch(jobs, out, workers)
+    rows = run_batch(jobs, out, workers, scheduler)
     commit_files([(os.path.join(out, "summary.csv"), _csv(rows).encode()),
                   (os.path.join(out, "summary.json"), (json.dumps(rows, indent=2) + "\n").encode())])
     counts = {s: sum(r["status"] == s for r in rows) for s in
