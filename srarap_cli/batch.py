@@ -12,7 +12,8 @@ A manifest (YAML or JSON) lists jobs; paths are relative to the manifest::
         expect: {golden: golden/bar-twist.obj, tol: 1.0e-9, relative: true}
 
 A job is up to date when its output exists and the sidecar ``<output>.srarap.json`` records
-the same fingerprint (content of mesh and handle file, settings, srarap version).
+the same fingerprint (content of the mesh, the handle file and every file it names, settings,
+srarap version).
 """
 import hashlib
 import json
@@ -80,10 +81,33 @@ def _settings(where, key, spec):
     return dict(spec)
 
 
+def referenced_files(handles):
+    """Files a handle file names (``.dmat``, ``.sel``, ``.def``, ...): every string in it that
+    is the path of an existing file, relative to the handle file; a ``.sel`` brings its ``.def``."""
+    base = os.path.dirname(os.path.abspath(handles))
+    if handles.lower().endswith(".sel"):
+        return [os.path.splitext(handles)[0] + ".def"]
+    try:
+        with open(handles, encoding="utf-8") as fh:
+            doc = yaml.safe_load(fh)  # JSON is YAML too
+    except (OSError, ValueError, yaml.YAMLError):
+        return []
+    found, stack = [], [doc]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, dict):
+            stack.extend(item.values())
+        elif isinstance(item, list):
+            stack.extend(item)
+        elif isinstance(item, str) and os.path.isfile(os.path.join(base, item)):
+            found.append(os.path.join(base, item))
+    return sorted(set(found))
+
+
 def fingerprint(job):
     """Content hash of everything that decides a job's output."""
     h = hashlib.sha256()
-    for path in (job["mesh"], job["handles"]):
+    for path in (job["mesh"], job["handles"], *referenced_files(job["handles"])):
         try:
             with open(path, "rb") as fh:
                 h.update(hashlib.sha256(fh.read()).digest())

@@ -94,3 +94,16 @@ def test_a_dask_cluster_gives_the_same_results_as_local_workers(tmp_path):
         assert (tmp_path / "dask" / f"{n}.obj").read_bytes() == \
             (tmp_path / "local" / f"{n}.obj").read_bytes()
         assert remote_rows[n]["iterations"] == local_rows[n]["iterations"]
+
+
+def test_editing_a_file_the_handle_file_names_makes_the_job_run_again(tmp_path):
+    (tmp_path / "move.def").write_text("1 0 0 0.5\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    (tmp_path / "h.yaml").write_text(yaml.safe_dump({"groups": {
+        "base": {"box": {"min": [-2, -2, -0.01], "max": [2, 2, 0.01]}, "fixed": True},
+        "top": {"box": {"min": [-2, -2, 9.99], "max": [2, 2, 10.01]}, "matrix": "move.def"}}}))
+    jobs = [{"name": "m", "mesh": BAR, "handles": str(tmp_path / "h.yaml"), "output": "m.obj"}]
+    path = manifest(tmp_path, jobs)
+    assert run(path, tmp_path / "out")[1]["m"]["status"] == "ok"
+    assert run(path, tmp_path / "out")[1]["m"]["status"] == "up-to-date"
+    (tmp_path / "move.def").write_text("1 0 0 0.7\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    assert run(path, tmp_path / "out")[1]["m"]["status"] == "ok"
