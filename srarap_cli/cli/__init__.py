@@ -6,6 +6,7 @@ from .batch import batch
 from .bench import bench
 from .compare import compare
 from .deform import deform
+from .render import plot, render
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -20,3 +21,5 @@ main.add_command(bench)
 main.add_command(animate)
 main.add_command(compare)
 main.add_command(batch)
+main.add_command(render)
+main.add_command(plot)

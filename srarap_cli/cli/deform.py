@@ -4,6 +4,7 @@ import os
 import click
 
 from .. import exit_codes
+from ..distortion import vertex_distortion
 from ..handles import load_handles
 from ..limits import check_solve
 from ..local_step import METHODS
@@ -12,6 +13,7 @@ from ..mesh_io.commit import commit_files
 from ..pipeline import deform_mesh, settings
 from ..solve_log import LOG_FORMATS, format_log
 from .common import check_output_path, guarded, solver_options
+from .render import preview_png
 
 
 @click.command("deform")
@@ -24,10 +26,13 @@ from .common import check_output_path, guarded, solver_options
 @solver_options
 @click.option("--method", type=click.Choice(tuple(METHODS)),
               help="Local step (see README). [default: sr-linear-sym]")
+@click.option("--preview", help="Also write a PNG: rest and deformed shape, handles coloured.")
+@click.option("--write-distortion", is_flag=True,
+              help="Add a per-vertex 'distortion' property to PLY output.")
 @click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
 @guarded
 def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, method, sweeps,
-           quiet):
+           preview, write_distortion, quiet):
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
@@ -35,6 +40,10 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, met
     2 usage, 4 invalid input, 5 numerical failure, 6 output error.
     """
     check_output_path(out, WRITE_FORMATS, "output")
+    if preview is not None:
+        check_output_path(preview, (".png",), "preview")
+    if write_distortion and not out.lower().endswith(".ply"):
+        raise click.UsageError("--write-distortion needs a .ply output")
     if log is not None:
         check_output_path(log, LOG_FORMATS, "log")
         if os.path.abspath(log) == os.path.abspath(out):
@@ -45,8 +54,13 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, met
     overrides = {"alpha": alpha, "feedback": feedback, "max_iter": max_iter, "tol": tol,
                  "weights": weights, "method": method, "sweeps": sweeps}
     deformed, result, notes = deform_mesh(source, constraints, **overrides)
+    if write_distortion:
+        deformed.vertex_data["distortion"] = vertex_distortion(
+            source.vertices, deformed.vertices, source.triangles()[0])
     mesh_bytes, lost = format_mesh(deformed, os.path.splitext(out)[1].lower())
     files = [(out, mesh_bytes)]
+    if preview is not None:
+        files.append((preview, preview_png(deformed, source, constraints, view="iso")))
     if log is not None:
         files.append((log, format_log(result.log, os.path.splitext(log)[1].lower()).encode()))
     commit_files(files)

@@ -1,0 +1,138 @@
+"""``srarap render`` and ``srarap plot``: pictures of meshes and of energy logs."""
+import csv
+import json
+import os
+
+import click
+import numpy as np
+
+from ..distortion import vertex_distortion
+from ..handles import load_handles
+from ..mesh_io import read_mesh
+from ..mesh_io.commit import commit_files
+from ..render import VIEWS, face_colors, render_png
+from .common import check_output_path, guarded
+
+
+def parse_size(text):
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise click.BadParameter(f"{text!r}: expected WIDTHxHEIGHT, e.g. 800x600") from None
+    if not (16 <= w <= 8000 and 16 <= h <= 8000):
+        raise click.BadParameter(f"{text!r}: width and height must be 16 to 8000 pixels")
+    return w, h
+
+
+def preview_png(mesh, rest=None, constraints=None, color="shade", layout="side", view="iso",
+                size=(800, 600)):
+    """PNG bytes of ``mesh`` (and its ``rest`` shape), handles coloured or distortion mapped."""
+    F = mesh.triangles()[0]
+    groups = list(constraints.groups.values()) if constraints is not None else None
+    colorbar = None
+    if color == "distortion":
+        d = vertex_distortion(rest.vertices, mesh.vertices, F)
+        vmax = max(float(d.max()), 1e-12)
+        colors = face_colors(F, scalar=d, vmax=vmax)
+        colorbar = ("distortion (relative strain)", vmax)
+    else:
+        colors = face_colors(F, groups)
+    current = [(mesh.vertices, F, colors, 1.0)]
+    if rest is None:
+        panels = [current]
+    else:
+        rest_item = (rest.vertices, F, face_colors(F, groups), 1.0)
+        panels = [[rest_item], current] if layout == "side" else \
+            [[(rest.vertices, F, face_colors(F), 0.25)] + current]
+    return render_png(panels, size, view, colorbar)
+
+
+@click.command("render")
+@click.argument("mesh")
+@click.option("-o", "--output", "out", required=True, help="PNG to write.")
+@click.option("--handles", help="Handle file: its groups are coloured (selected on the rest shape).")
+@click.option("--rest", help="Rest mesh (same vertices): shown beside or behind, and needed "
+              "for --color distortion.")
+@click.option("--color", type=click.Choice(["shade", "distortion"]), default="shade",
+              show_default=True)
+@click.option("--layout", type=click.Choice(["side", "ghost"]), default="side", show_default=True,
+              help="Rest shape beside the mesh, or ghosted behind it.")
+@click.option("--view", default="iso", show_default=True,
+              help=f"{', '.join(VIEWS)}, or a viewing direction 'x,y,z'.")
+@click.option("--size", default="800x600", show_default=True, help="WIDTHxHEIGHT in pixels.")
+@guarded
+def render(mesh, out, handles, rest, color, layout, view, size):
+    """Render MESH to a PNG, headless."""
+    check_output_path(out, (".png",), "output")
+    size = parse_size(size)
+    _check_view(view)
+    shown = read_mesh(mesh)
+    base = read_mesh(rest) if rest else None
+    if base is not None and len(base.vertices) != len(shown.vertices):
+        raise click.BadParameter("the rest mesh must have the same vertices", param_hint="--rest")
+    if color == "distortion" and base is None:
+        raise click.UsageError("--color distortion needs --rest")
+    constraints = load_handles(handles, (base or shown).vertices) if handles else None
+    commit_files([(out, preview_png(shown, base, constraints, color, layout, view, size))])
+
+
+def _check_view(view):
+    if view in VIEWS:
+        return
+    try:
+        d = np.array([float(x) for x in view.split(",")])
+    except ValueError:
+        d = np.zeros(0)
+    if d.shape != (3,) or not np.isfinite(d).all() or np.linalg.norm(d) == 0:
+        raise click.BadParameter(f"{view!r}: a view name ({', '.join(VIEWS)}) or 'x,y,z'",
+                                 param_hint="--view")
+
+
+@click.command("plot")
+@click.argument("logs", nargs=-1, required=True)
+@click.option("-o", "--output", "out", required=True, help="PNG to write.")
+@click.option("--size", default="1000x420", show_default=True, help="WIDTHxHEIGHT in pixels.")
+@guarded
+def plot(logs, out, size):
+    """Plot total energy against iteration and time for one or more deform logs (CSV/JSONL)."""
+    check_output_path(out, (".png",), "output")
+    w, h = parse_size(size)
+    import io
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (a, b) = plt.subplots(1, 2, figsize=(w / 100, h / 100), dpi=100)
+    for path in logs:
+        rows = _read_log(path)
+        it = [int(r["iteration"]) for r in rows]
+        e = [float(r["total"]) for r in rows]
+        t = [max(float(r["seconds"]), 1e-4) for r in rows]
+        a.semilogy(it, e, label=os.path.basename(path))
+        b.loglog(t, e, label=os.path.basename(path))
+    for ax, xl in ((a, "iteration"), (b, "wall time [s]")):
+        ax.set_xlabel(xl)
+        ax.set_ylabel("total energy")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    plt.close(fig)
+    commit_files([(out, buf.getvalue())])
+
+
+def _read_log(path):
+    from ..errors import InputError
+    try:
+        with open(path, encoding="utf-8") as fh:
+            if path.lower().endswith(".csv"):
+                rows = list(csv.DictReader(fh))
+            else:
+                rows = [json.loads(line) for line in fh if line.strip()]
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: not a readable log ({exc})") from None
+    if not rows or not {"iteration", "total", "seconds"} <= set(rows[0]):
+        raise InputError(f"{path}: not a srarap deform log (needs iteration, total, seconds)")
+    return rows

@@ -1,0 +1,109 @@
+"""Headless previews: shaded meshes under an orthographic camera, drawn with matplotlib.
+
+Triangles are projected, sorted back to front and drawn as one flat 2D polygon collection with
+Lambert shading, which stays fast on large meshes (no 3D axes).
+"""
+import io
+
+import numpy as np
+
+VIEWS = {"front": ([0, -1, 0], [0, 0, 1]), "back": ([0, 1, 0], [0, 0, 1]),
+         "left": ([1, 0, 0], [0, 0, 1]), "right": ([-1, 0, 0], [0, 0, 1]),
+         "top": ([0, 0, -1], [0, 1, 0]), "iso": ([-1, -1, -0.8], [0, 0, 1])}
+BASE = np.array([0.78, 0.78, 0.80])
+PALETTE = np.array([[0.90, 0.30, 0.25], [0.20, 0.50, 0.90], [0.25, 0.75, 0.35],
+                    [0.95, 0.65, 0.15], [0.60, 0.35, 0.80], [0.10, 0.75, 0.75]])
+
+
+def camera(view):
+    """Unit viewing direction and the image's up/right axes for a view name or 'x,y,z'."""
+    if view in VIEWS:
+        d, up = (np.asarray(v, float) for v in VIEWS[view])
+    else:
+        d = np.array([float(x) for x in view.split(",")])
+        up = np.array([0.0, 0, 1]) if abs(d[2]) < 0.9 * np.linalg.norm(d) else np.array([0.0, 1, 0])
+    d = d / np.linalg.norm(d)
+    right = np.cross(d, up)
+    right /= np.linalg.norm(right)
+    return d, np.cross(right, d), right
+
+
+def face_shading(V, F, d):
+    """Two-sided Lambert intensity per face, light from the viewer's upper left."""
+    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    light = -d + 0.3 * np.cross(d, [0.0, 0, 1]) if abs(d[2]) < 0.99 else -d
+    light /= np.linalg.norm(light)
+    return 0.35 + 0.65 * np.abs(n @ light)
+
+
+def draw(ax, V, F, colors, view, alpha=1.0):
+    """Draw one mesh on matplotlib axes ``ax``; returns its 2D bounding box (x0, x1, y0, y1)."""
+    from matplotlib.collections import PolyCollection
+    d, up, right = camera(view)
+    xy = np.column_stack([V @ right, V @ up])
+    depth = (V @ d)[F].mean(axis=1)
+    order = np.argsort(-depth, kind="stable")  # farthest first
+    shade = face_shading(V, F, d)[:, None]
+    rgba = np.column_stack([np.clip(colors * shade, 0, 1), np.full(len(F), alpha)])
+    ax.add_collection(PolyCollection(xy[F[order]], facecolors=rgba[order], edgecolors="none",
+                                     antialiaseds=False))
+    return xy[:, 0].min(), xy[:, 0].max(), xy[:, 1].min(), xy[:, 1].max()
+
+
+def face_colors(F, vertex_groups=None, scalar=None, vmax=None):
+    """Per-face RGB: base grey, handle groups from the palette, or a viridis scalar."""
+    if scalar is not None:
+        from matplotlib import colormaps
+        values = scalar[F].mean(axis=1) / (vmax if vmax else max(scalar.max(), 1e-300))
+        return colormaps["viridis"](np.clip(values, 0, 1))[:, :3]
+    out = np.tile(BASE, (len(F), 1))
+    if vertex_groups is not None:
+        for k, ids in enumerate(vertex_groups):
+            mark = np.zeros(int(F.max()) + 1, dtype=bool)
+            mark[ids[ids <= F.max()]] = True
+            out[mark[F].any(axis=1)] = PALETTE[k % len(PALETTE)]
+    return out
+
+
+def render_png(panels, size=(800, 600), view="iso", colorbar=None):
+    """PNG bytes of one or more panels side by side.
+
+    Parameters
+    ----------
+    panels : list of list of (V, F, colors, alpha): meshes per panel, drawn in order
+    size : (width, height) in pixels
+    view : a VIEWS name or 'x,y,z' viewing direction
+    colorbar : (label, vmax) to add a viridis colour bar, optional
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
+    dpi = 100
+    fig = plt.figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
+    width = 0.88 if colorbar else 1.0
+    boxes = []
+    axes = []
+    for k, meshes in enumerate(panels):
+        ax = fig.add_axes([k * width / len(panels), 0, width / len(panels), 1])
+        ax.set_axis_off()
+        boxes += [draw(ax, V, F, c, view, a) for V, F, c, a in meshes]
+        axes.append(ax)
+    x0, x1 = min(b[0] for b in boxes), max(b[1] for b in boxes)
+    y0, y1 = min(b[2] for b in boxes), max(b[3] for b in boxes)
+    pad = 0.05 * max(x1 - x0, y1 - y0)
+    for ax in axes:
+        ax.set_xlim(x0 - pad, x1 + pad)
+        ax.set_ylim(y0 - pad, y1 + pad)
+        ax.set_aspect("equal", adjustable="box")
+    if colorbar:
+        cax = fig.add_axes([0.91, 0.1, 0.025, 0.8])
+        fig.colorbar(ScalarMappable(Normalize(0, colorbar[1]), "viridis"), cax=cax,
+                     label=colorbar[0])
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue()

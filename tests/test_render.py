@@ -1,0 +1,82 @@
+"""Previews, distortion maps and energy plots."""
+import os
+
+import meshio
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from helpers import ROOT, tube_mesh
+from matplotlib.image import imread
+
+from srarap_cli.cli import main
+from srarap_cli.distortion import vertex_distortion
+from srarap_cli.mesh_io import write_mesh
+from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli.render import PALETTE
+
+BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
+BEND = os.path.join(ROOT, "configs", "bar-bend.yaml")
+
+
+def invoke(*args):
+    return CliRunner().invoke(main, [*map(str, args)])
+
+
+def near(img, rgb, tol=0.12):
+    return (np.abs(img[..., :3] - rgb).max(axis=-1) < tol)
+
+
+def test_render_has_the_size_asked_and_colours_handles_where_they_project(tmp_path):
+    out = tmp_path / "p.png"
+    r = invoke("render", BAR, "--handles", BEND, "--view", "front", "--size", "300x600",
+               "-o", out)
+    assert r.exit_code == 0, r.output
+    img = imread(str(out))
+    assert img.shape[:2] == (600, 300)
+    assert img[..., :3].std() > 0.05  # not blank
+    # front view, z up: the tip group (second, blue) at the top, the base (first, red) at the
+    # bottom; neither colour in the middle of the bar
+    rows = np.arange(600)
+    blue, red = near(img, PALETTE[1], 0.35), near(img, PALETTE[0], 0.35)
+    assert blue.any() and red.any()
+    assert rows[blue.any(axis=1)].max() < 120 and rows[red.any(axis=1)].min() > 480
+    assert not (blue | red)[250:350].any()
+
+
+def test_distortion_is_zero_for_rigid_motion_and_measures_stretch():
+    m = tube_mesh(rings=6, segments=8)
+    V, F = m.vertices, m.triangles()[0]
+    R = to_matrix(from_axis_angle([1, 2, 3], 130))
+    assert vertex_distortion(V, V @ R.T + [4, 5, 6], F).max() < 1e-12
+    stretched = vertex_distortion(V, 1.1 * V, F)
+    assert np.allclose(stretched[stretched > 0], 0.1, atol=1e-9)
+
+
+def test_distortion_render_needs_rest_and_draws_a_colour_bar(tmp_path):
+    m = tube_mesh(rings=6, segments=8)
+    write_mesh(str(tmp_path / "rest.obj"), m)
+    write_mesh(str(tmp_path / "big.obj"), m.with_vertices(1.2 * m.vertices))
+    assert invoke("render", tmp_path / "big.obj", "--color", "distortion", "-o",
+                  tmp_path / "d.png").exit_code == 2
+    r = invoke("render", tmp_path / "big.obj", "--rest", tmp_path / "rest.obj", "--color",
+               "distortion", "--layout", "ghost", "-o", tmp_path / "d.png", "--size", "400x300")
+    assert r.exit_code == 0, r.output
+    assert imread(str(tmp_path / "d.png")).shape[:2] == (300, 400)
+
+
+@pytest.mark.parametrize("args", [["--size", "10x10"], ["--view", "0,0,0"], ["--size", "big"]])
+def test_bad_render_options_are_usage_errors(tmp_path, args):
+    assert invoke("render", BAR, "-o", tmp_path / "p.png", *args).exit_code == 2
+
+
+def test_deform_preview_distortion_ply_and_plot(tmp_path):
+    ply, png, log = tmp_path / "o.ply", tmp_path / "prev.png", tmp_path / "log.csv"
+    r = invoke("deform", BAR, BEND, "-o", ply, "--preview", png, "--write-distortion",
+               "--log", log, "-q")
+    assert r.exit_code == 0, r.output
+    d = meshio.read(str(ply)).point_data["distortion"]
+    assert np.isfinite(d).all() and d.max() > 0
+    assert imread(str(png)).shape[:2] == (600, 800)
+    r = invoke("plot", log, log, "-o", tmp_path / "e.png", "--size", "500x300")
+    assert r.exit_code == 0 and imread(str(tmp_path / "e.png")).shape[:2] == (300, 500)
+    assert invoke("plot", ply, "-o", tmp_path / "x.png").exit_code == 4
