@@ -51,6 +51,17 @@ def draw(ax, V, F, colors, view, alpha=1.0):
     return xy[:, 0].min(), xy[:, 0].max(), xy[:, 1].min(), xy[:, 1].max()
 
 
+def _frame(axes, boxes):
+    """The same limits on every axes of a view, around all its meshes, with a margin."""
+    x0, x1 = min(b[0] for b in boxes), max(b[1] for b in boxes)
+    y0, y1 = min(b[2] for b in boxes), max(b[3] for b in boxes)
+    pad = 0.05 * max(x1 - x0, y1 - y0, 1e-12)
+    for ax in axes:
+        ax.set_xlim(x0 - pad, x1 + pad)
+        ax.set_ylim(y0 - pad, y1 + pad)
+        ax.set_aspect("equal", adjustable="box")
+
+
 def face_colors(F, vertex_groups=None, scalar=None, vmax=None):
     """Per-face RGB: base grey, handle groups from the palette, or a viridis scalar."""
     if scalar is not None:
@@ -67,13 +78,14 @@ def face_colors(F, vertex_groups=None, scalar=None, vmax=None):
 
 
 def render_png(panels, size=(800, 600), view="iso", colorbar=None):
-    """PNG bytes of one or more panels side by side.
+    """PNG bytes of one or more panels side by side, for one or more views.
 
     Parameters
     ----------
     panels : list of list of (V, F, colors, alpha): meshes per panel, drawn in order
     size : (width, height) in pixels
-    view : a VIEWS name or 'x,y,z' viewing direction
+    view : a VIEWS name or 'x,y,z' viewing direction, or a list of them: every view gets its
+        own columns (one per panel), framed alike within the view
     colorbar : (label, vmax) to add a viridis colour bar, optional
     """
     import matplotlib
@@ -85,20 +97,17 @@ def render_png(panels, size=(800, 600), view="iso", colorbar=None):
     dpi = 100
     fig = plt.figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     width = 0.88 if colorbar else 1.0
-    boxes = []
-    axes = []
-    for k, meshes in enumerate(panels):
-        ax = fig.add_axes([k * width / len(panels), 0, width / len(panels), 1])
-        ax.set_axis_off()
-        boxes += [draw(ax, V, F, c, view, a) for V, F, c, a in meshes]
-        axes.append(ax)
-    x0, x1 = min(b[0] for b in boxes), max(b[1] for b in boxes)
-    y0, y1 = min(b[2] for b in boxes), max(b[3] for b in boxes)
-    pad = 0.05 * max(x1 - x0, y1 - y0)
-    for ax in axes:
-        ax.set_xlim(x0 - pad, x1 + pad)
-        ax.set_ylim(y0 - pad, y1 + pad)
-        ax.set_aspect("equal", adjustable="box")
+    views = [view] if isinstance(view, str) else list(view)
+    columns = len(views) * len(panels)
+    for v, name in enumerate(views):
+        boxes, axes = [], []
+        for k, meshes in enumerate(panels):
+            col = v * len(panels) + k
+            ax = fig.add_axes([col * width / columns, 0, width / columns, 1])
+            ax.set_axis_off()
+            boxes += [draw(ax, V, F, c, name, a) for V, F, c, a in meshes]
+            axes.append(ax)
+        _frame(axes, boxes)
     if colorbar:
         cax = fig.add_axes([0.91, 0.1, 0.025, 0.8])
         fig.colorbar(ScalarMappable(Normalize(0, colorbar[1]), "viridis"), cax=cax,

@@ -80,3 +80,16 @@ def test_deform_preview_distortion_ply_and_plot(tmp_path):
     r = invoke("plot", log, log, "-o", tmp_path / "e.png", "--size", "500x300")
     assert r.exit_code == 0 and imread(str(tmp_path / "e.png")).shape[:2] == (300, 500)
     assert invoke("plot", ply, "-o", tmp_path / "x.png").exit_code == 4
+
+
+def test_several_views_are_drawn_side_by_side(tmp_path):
+    out = tmp_path / "v.png"
+    r = invoke("render", BAR, "--handles", BEND, "--view", "front", "--view", "top",
+               "--size", "600x300", "-o", out)
+    assert r.exit_code == 0, r.output
+    img = imread(str(out))
+    left, right = img[:, :300, :3], img[:, 300:, :3]
+    assert left.std() > 0.05 and right.std() > 0.05
+    # from the top the tip cap (blue) covers the bar's disc; from the front only a band
+    blue = near(img, PALETTE[1], 0.35)
+    assert blue[:, 300:].sum() > 3 * blue[:, :300].sum()

@@ -57,15 +57,17 @@ def preview_png(mesh, rest=None, constraints=None, color="shade", layout="side",
               show_default=True)
 @click.option("--layout", type=click.Choice(["side", "ghost"]), default="side", show_default=True,
               help="Rest shape beside the mesh, or ghosted behind it.")
-@click.option("--view", default="iso", show_default=True,
-              help=f"{', '.join(VIEWS)}, or a viewing direction 'x,y,z'.")
+@click.option("--view", "views", multiple=True, default=("iso",), show_default=True,
+              help=f"{', '.join(VIEWS)}, or a viewing direction 'x,y,z'; repeat for "
+                   "several views side by side.")
 @click.option("--size", default="800x600", show_default=True, help="WIDTHxHEIGHT in pixels.")
 @guarded
-def render(mesh, out, handles, rest, color, layout, view, size):
+def render(mesh, out, handles, rest, color, layout, views, size):
     """Render MESH to a PNG, headless."""
     check_output_path(out, (".png",), "output")
     size = parse_size(size)
-    _check_view(view)
+    for view in views:
+        _check_view(view)
     shown = read_mesh(mesh)
     base = read_mesh(rest) if rest else None
     if base is not None and len(base.vertices) != len(shown.vertices):
@@ -73,7 +75,8 @@ def render(mesh, out, handles, rest, color, layout, view, size):
     if color == "distortion" and base is None:
         raise click.UsageError("--color distortion needs --rest")
     constraints = load_handles(handles, (base or shown).vertices) if handles else None
-    commit_files([(out, preview_png(shown, base, constraints, color, layout, view, size))])
+    commit_files([(out, preview_png(shown, base, constraints, color, layout, list(views),
+                                    size))])
 
 
 def _check_view(view):
