@@ -7,13 +7,13 @@ wall times and their ratio. One job is deliberately broken: it must be reported,
 Run: python benchmarks/batch_speedup.py [--jobs 200]
 """
 import argparse
-import importlib.util
 import os
 import subprocess
 import tempfile
 import time
 
 import yaml
+from make_big_bar import load_make_bar
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -22,10 +22,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--jobs", type=int, default=200)
     args = ap.parse_args()
-    spec = importlib.util.spec_from_file_location(
-        "make_bar", os.path.join(ROOT, "sample_meshes", "make_bar.py"))
-    make_bar = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(make_bar)
+    make_bar = load_make_bar()
     work = tempfile.mkdtemp(prefix="srarap-batch-")
     jobs = []
     for k in range(args.jobs):

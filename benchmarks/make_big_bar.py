@@ -9,16 +9,22 @@ import os
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
+def load_make_bar():
+    """The sample generator ``sample_meshes/make_bar.py`` as a module (it is a script)."""
+    spec = importlib.util.spec_from_file_location(
+        "make_bar", os.path.join(ROOT, "sample_meshes", "make_bar.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out")
     ap.add_argument("--rings", type=int, default=624)
     ap.add_argument("--segments", type=int, default=160)
     args = ap.parse_args()
-    spec = importlib.util.spec_from_file_location(
-        "make_bar", os.path.join(ROOT, "sample_meshes", "make_bar.py"))
-    make_bar = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(make_bar)
+    make_bar = load_make_bar()
     V, faces, uv, tfaces = make_bar.bar(rings=args.rings, segments=args.segments)
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     with open(args.out, "w") as fh:
