@@ -36,7 +36,7 @@ def main():
                 "tip": {"box": {"min": [-2, -2, 5.99], "max": [2, 2, 6.01]},
                         "rotate": {"axis": [0, 1, 0], "angle": 10 + k % 50}}}}, fh)
         jobs.append({"name": f"job{k}", "mesh": mesh, "handles": handles, "output": f"out{k}.obj"})
-    jobs[7]["mesh"] = os.path.join(work, "missing.obj")
+    jobs[len(jobs) // 2]["mesh"] = os.path.join(work, "missing.obj")
     manifest = os.path.join(work, "jobs.yaml")
     with open(manifest, "w") as fh:
         yaml.safe_dump({"defaults": {"max_iter": 200}, "jobs": jobs}, fh)
