@@ -1,6 +1,6 @@
 """Time a manifest of many small jobs run sequentially and with 2 worker processes.
 
-Writes small tubes (made by sample_meshes/make_bar.py) and a manifest of N jobs bending them,
+Writes small tubes (srarap_cli.samples, as the sample bar) and a manifest of N jobs bending them,
 runs `srarap batch` with --workers 1 and --workers 2 in fresh output folders, and prints both
 wall times and their ratio. One job is deliberately broken: it must be reported, not fatal.
 
@@ -13,22 +13,20 @@ import tempfile
 import time
 
 import yaml
-from make_big_bar import load_make_bar
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from srarap_cli.samples import bar, obj_text
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--jobs", type=int, default=200)
     args = ap.parse_args()
-    make_bar = load_make_bar()
     work = tempfile.mkdtemp(prefix="srarap-batch-")
     jobs = []
     for k in range(args.jobs):
         mesh = os.path.join(work, f"tube{k}.obj")
         with open(mesh, "w") as fh:
-            fh.write(make_bar.obj_text(*make_bar.bar(length=6, rings=8 + k % 5, segments=8)))
+            fh.write(obj_text(*bar(length=6, rings=8 + k % 5, segments=8)))
         handles = os.path.join(work, f"h{k}.yaml")
         with open(handles, "w") as fh:
             yaml.safe_dump({"groups": {

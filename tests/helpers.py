@@ -1,26 +1,18 @@
 """Small meshes made in the tests (no files needed)."""
-import importlib.util
 import os
 
 import numpy as np
 
 from srarap_cli.mesh_io.mesh import Mesh
+from srarap_cli.samples import bar
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")
 
 
-def _make_bar():
-    spec = importlib.util.spec_from_file_location(
-        "make_bar", os.path.join(ROOT, "sample_meshes", "make_bar.py"))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def tube_mesh(length=6.0, rings=12, segments=8):
     """Capped tube along z (quads + triangle fans, UVs with a seam) as a Mesh."""
-    V, faces, uv, tfaces = _make_bar().bar(length=length, rings=rings, segments=segments)
+    V, faces, uv, tfaces = bar(length=length, rings=rings, segments=segments)
     return Mesh(vertices=V, face_sizes=np.array([len(f) for f in faces]),
                 face_vertices=np.concatenate(faces), uv=uv, face_uv=np.concatenate(tfaces))
 

@@ -115,6 +115,12 @@ def test_sel_file_alone_uses_the_def_beside_it(tmp_path):
      "short.dmat has 3 entries but the mesh has"),
     ({"tip": {"dmat": {"file": "missing.dmat", "group": 0}, "fixed": True}}, "no such file"),
     ({}, "'groups' must map at least one group"),
+    ({"tip": {"sphere": {"center": [0, 0, 0]}, "fixed": True}},
+     "group 'tip': sphere needs 'center' and 'radius'"),
+    ({"tip": {"box": {"min": [0, 0, 0]}, "fixed": True}}, "box needs 'min' and 'max'"),
+    ({"tip": {"dmat": {"file": "short.dmat"}, "fixed": True}}, "dmat needs 'file' and 'group'"),
+    ({"tip": {"sel": {"status": "handle"}, "fixed": True}}, "sel needs 'file' and 'status'"),
+    ({"tip": {"box": [0, 1], "fixed": True}}, "box must be a mapping"),
 ])
 def test_invalid_handle_files_name_group_and_field(tmp_path, groups, message):
     (tmp_path / "short.dmat").write_text("1 3\n0\n0\n0\n")

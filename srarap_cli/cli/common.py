@@ -25,7 +25,7 @@ class Terminated(BaseException):
     """SIGTERM arrived; raised so that cleanup (temporary files) runs on the way out."""
 
 
-def _on_sigterm(signum, frame):
+def _on_sigterm(_signum, _frame):
     raise Terminated()
 
 

@@ -27,6 +27,14 @@ class Context:
                              f"(allowed: {', '.join(sorted(allowed))})")
         return value
 
+    def record(self, value, name, keys):
+        """A mapping with exactly ``keys``, all of them required."""
+        value = self.mapping(value, name, keys)
+        missing = [k for k in keys if k not in value]
+        if missing:
+            raise self.error(f"{name} needs " + " and ".join(f"{k!r}" for k in keys))
+        return value
+
     def vector(self, value, name, length):
         arr = self.numbers(value, name)
         if arr.shape != (length,):

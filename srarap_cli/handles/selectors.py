@@ -25,18 +25,14 @@ def _indices(ctx, spec, V, base):
 
 
 def _sphere(ctx, spec, V, base):
-    spec = ctx.mapping(spec, "sphere", ("center", "radius"))
-    if "center" not in spec or "radius" not in spec:
-        raise ctx.error("sphere needs 'center' and 'radius'")
+    spec = ctx.record(spec, "sphere", ("center", "radius"))
     center = ctx.vector(spec["center"], "center", 3)
     radius = ctx.number(spec["radius"], "radius", 0, strict=True)
     return np.flatnonzero(np.sum((V - center) ** 2, axis=1) <= radius * radius)
 
 
 def _box(ctx, spec, V, base):
-    spec = ctx.mapping(spec, "box", ("min", "max"))
-    if "min" not in spec or "max" not in spec:
-        raise ctx.error("box needs 'min' and 'max'")
+    spec = ctx.record(spec, "box", ("min", "max"))
     lo, hi = ctx.vector(spec["min"], "min", 3), ctx.vector(spec["max"], "max", 3)
     if (lo > hi).any():
         raise ctx.error("box: min must not exceed max in any coordinate")
@@ -50,18 +46,14 @@ def _checked_length(ctx, values, V, path):
 
 
 def _dmat(ctx, spec, V, base):
-    spec = ctx.mapping(spec, "dmat", ("file", "group"))
-    if "file" not in spec or "group" not in spec:
-        raise ctx.error("dmat needs 'file' and 'group'")
+    spec = ctx.record(spec, "dmat", ("file", "group"))
     path = _file(ctx, base, spec["file"], "dmat file")
     group = ctx.integer(spec["group"], "dmat group", 0)
     return np.flatnonzero(_checked_length(ctx, read_dmat(path), V, path) == group)
 
 
 def _sel(ctx, spec, V, base):
-    spec = ctx.mapping(spec, "sel", ("file", "status"))
-    if "file" not in spec or "status" not in spec:
-        raise ctx.error("sel needs 'file' and 'status' (fixed, free or handle)")
+    spec = ctx.record(spec, "sel", ("file", "status"))
     if spec["status"] not in SEL_STATUS:
         raise ctx.error("sel status must be one of fixed, free, handle")
     path = _file(ctx, base, spec["file"], "sel file")

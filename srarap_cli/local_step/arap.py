@@ -24,7 +24,7 @@ class ArapRotorStep:
     bending = False
 
     def __init__(self, edges, constrained, alpha_area, feedback):
-        pass
+        """Nothing to precompute: each step fits rotations to the covariances alone."""
 
     def step(self, S, s, R_prev):
         return align_hemisphere(from_matrix(closest_rotations(S)), R_prev)

@@ -42,7 +42,6 @@ class RotorSystem:
         self.free = np.flatnonzero(~constrained)
         self.fixed = np.flatnonzero(constrained)
         self.sigma, self.tau, self.phi = sigma, tau, phi
-        self.cg_iterations = 0
         W = sp.csr_matrix((omega, (graph.I, graph.J)), shape=(graph.n,) * 2)
         self._fixed_rows = W[self.fixed]
         self._free_to_fixed = W[self.free][:, self.fixed].tocsr()
@@ -99,14 +98,8 @@ class RotorSystem:
         solve = self._precondition
         precond = spla.LinearOperator(
             A.shape, matvec=lambda v: solve(np.asfortranarray(v.reshape(-1, 4))).ravel())
-        count = [0]
-
-        def tick(_):
-            count[0] += 1
-
         x, info = spla.cg(A, b, x0=x0, rtol=CG_RTOL, atol=0.0, M=precond,
-                          maxiter=max(200, 4 * A.shape[0]), callback=tick)
-        self.cg_iterations = count[0]
+                          maxiter=max(200, 4 * A.shape[0]))
         if info != 0:
             x = factor(A, symmetric=True)(b)
         return x
