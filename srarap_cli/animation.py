@@ -53,13 +53,14 @@ class Animator:
     mesh : Mesh
     constraints : Constraints, with ``tracks`` for the keyframed groups
     opts : dict, resolved solver settings (see ``pipeline.settings``)
+    cache : str, optional, folder for multiresolution coarse meshes
     """
 
-    def __init__(self, mesh, constraints, opts):
+    def __init__(self, mesh, constraints, opts, cache=None):
         self.mesh = mesh
         self.constraints = constraints
         self.problem = problem(mesh, constraints)
-        self.deformer = build_deformer(self.problem, opts)
+        self.deformer = build_deformer(self.problem, opts, cache)
 
     def run(self, frames, *, iters_per_frame, tol, state=None, on_frame=None, fingerprint=""):
         """Solve frames ``state.frame + 1`` (or 0) to ``frames - 1``.
@@ -81,10 +82,10 @@ class Animator:
             dot = 1.0 if R is None else float(np.einsum("ij,ij->i", result.rotors, R).min())
             R = result.rotors if R is None else align_hemisphere(result.rotors, R)
             P = result.positions
-            last = result.log[-1]
+            energy = result.energies()
             rows.append({"frame": f, "iterations": result.iterations,
-                         "membrane": last["membrane"], "bending": last["bending"],
-                         "total": last["total"], "converged": result.converged,
+                         "membrane": energy["membrane"], "bending": energy["bending"],
+                         "total": energy["total"], "converged": result.converged,
                          "min_rotor_dot": dot, "seconds": time.perf_counter() - start})
             state = FrameState(f, P, R, list(rows), fingerprint)
             if on_frame is not None:

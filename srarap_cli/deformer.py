@@ -35,6 +35,12 @@ class DeformResult:
     log : list of dict, one per iteration (0 is the Laplacian-editing start), keys LOG_FIELDS
     converged : bool, relative energy change fell below ``tol``
     iterations : int, local/global iterations run
+    full_energy : dict or None
+        ``membrane``, ``bending``, ``total`` of the returned positions and rotors when they
+        differ from the last log row (multiresolution: the log follows the coarse mesh)
+    stages : dict, seconds per stage of a multiresolution solve (empty otherwise)
+    coarse : dict or None, multiresolution only: ``vertices`` (coarse count) and
+        ``cache_hit`` (the coarse mesh came from the cache)
     """
 
     positions: np.ndarray
@@ -42,10 +48,18 @@ class DeformResult:
     log: list = field(default_factory=list)
     converged: bool = False
     iterations: int = 0
+    full_energy: dict = None
+    stages: dict = field(default_factory=dict)
+    coarse: dict = None
+
+    def energies(self):
+        """``membrane``, ``bending`` and ``total`` energy of the returned shape."""
+        source = self.log[-1] if self.full_energy is None else self.full_energy
+        return {k: source[k] for k in ("membrane", "bending", "total")}
 
     @property
     def energy(self):
-        return self.log[-1]["total"]
+        return self.energies()["total"]
 
 
 class Deformer:
@@ -102,8 +116,9 @@ class Deformer:
         self.constrained = np.asarray(constrained, dtype=np.int64).ravel()
         mask = np.zeros(len(self.V), dtype=bool)
         mask[self.constrained] = True
-        self.warnings = _weight_warnings(self.graph)
-        self.auto_fixed = self._unanchored(mask)
+        self.warnings = weight_warnings(self.graph)
+        self.auto_fixed, notes = unanchored(self.graph, mask)
+        self.warnings += notes
         mask[self.auto_fixed] = True
         self._fixed = np.flatnonzero(mask)
         self._slot = np.searchsorted(self._fixed, self.constrained)
@@ -115,20 +130,6 @@ class Deformer:
         self.method = method
         self.local_step = step_class(self.edges, mask, self.alpha * self.area, feedback, **extra)
         self._bending_alpha = self.alpha if step_class.bending else 0.0
-
-    def _unanchored(self, mask):
-        n_parts, label = csgraph.connected_components(self.graph.laplacian, directed=False)
-        anchored = np.zeros(n_parts, dtype=bool)
-        anchored[label[mask]] = True
-        lonely = np.flatnonzero(self.graph.degree == 0)
-        floating = np.flatnonzero(~anchored[label] & (self.graph.degree > 0))
-        if lonely.size:
-            self.warnings.append(f"{lonely.size} unreferenced vertices kept at rest")
-        if floating.size:
-            parts = np.unique(label[floating]).size
-            self.warnings.append(f"{parts} connected part(s) without a constrained vertex "
-                                 f"({floating.size} vertices) kept at rest")
-        return np.union1d(lonely, floating)
 
     def _fixed_targets(self, targets):
         full = self.V[self._fixed].copy()
@@ -220,7 +221,32 @@ class Deformer:
         return row
 
 
-def _weight_warnings(graph):
+def unanchored(graph, constrained):
+    """Vertices nothing can move: unreferenced ones and every connected part without a
+    constrained vertex. Returns their sorted ids and a warning per kind found.
+
+    Parameters
+    ----------
+    graph : CellGraph
+    constrained : (n,) bool array
+    """
+    n_parts, label = csgraph.connected_components(graph.laplacian, directed=False)
+    anchored = np.zeros(n_parts, dtype=bool)
+    anchored[label[constrained]] = True
+    lonely = np.flatnonzero(graph.degree == 0)
+    floating = np.flatnonzero(~anchored[label] & (graph.degree > 0))
+    notes = []
+    if lonely.size:
+        notes.append(f"{lonely.size} unreferenced vertices kept at rest")
+    if floating.size:
+        parts = np.unique(label[floating]).size
+        notes.append(f"{parts} connected part(s) without a constrained vertex "
+                     f"({floating.size} vertices) kept at rest")
+    return np.union1d(lonely, floating), notes
+
+
+def weight_warnings(graph):
+    """Warnings about edge weights that can keep a solve from settling."""
     out = []
     if graph.degenerate:
         out.append(f"{graph.degenerate} triangle angles of zero-area faces have no finite "

@@ -5,12 +5,14 @@ import numpy as np
 
 from .deformer import Deformer, DeformResult
 from .mesh_checks import mesh_warnings, solvable_faces
+from .multires import MultiresDeformer, coarse_size
 from .operators import mesh_area
 from .quaternion import IDENTITY
 from .region import restrict
 
 DEFAULTS = {"alpha": 0.14, "feedback": 0.2, "max_iter": 1000, "tol": 1e-6,
-            "weights": "cotan-clamped", "method": "sr-linear-sym", "sweeps": 2}
+            "weights": "cotan-clamped", "method": "sr-linear-sym", "sweeps": 2,
+            "multires": "auto"}
 
 
 def settings(file_settings, overrides):
@@ -30,6 +32,8 @@ class Problem:
     vertices : (s,) int array, ids in the full mesh
     V : (s, 3) float array; F : (f, 3) int array, in solve ids
     ids : (k,) int array, constrained solve ids; targets : (k, 3) float array
+    labels : (k,) int array, handle group of each constrained vertex (the file's first group
+        holding it; vertices a region holds at rest form one more group)
     area : float or None, the whole mesh's area when the solve covers only a region
     """
 
@@ -38,6 +42,7 @@ class Problem:
     F: np.ndarray
     ids: np.ndarray
     targets: np.ndarray
+    labels: np.ndarray
     area: float = None
     sub: object = None
 
@@ -56,17 +61,34 @@ def problem(mesh, constraints):
     V = mesh.vertices
     F = solvable_faces(mesh.triangles()[0])
     if constraints.region is None:
-        return Problem(np.arange(len(V)), V, F, constraints.ids, constraints.targets)
+        return Problem(np.arange(len(V)), V, F, constraints.ids, constraints.targets,
+                       _labels(constraints, constraints.ids))
     sub = restrict(V, F, constraints.ids, constraints.targets, constraints.region)
     return Problem(sub.vertices, V[sub.vertices], sub.faces, sub.constrained, sub.targets,
-                   mesh_area(V, F), sub)
+                   _labels(constraints, sub.vertices[sub.constrained]), mesh_area(V, F), sub)
 
 
-def build_deformer(p, opts):
-    """The :class:`Deformer` of a :class:`Problem` with resolved settings ``opts``."""
-    return Deformer(p.V, p.F, p.ids, alpha=opts["alpha"], feedback=opts["feedback"],
-                    weights=opts["weights"], area=p.area, method=opts["method"],
-                    sweeps=opts["sweeps"])
+def _labels(constraints, full_ids):
+    labels = np.full(len(full_ids), len(constraints.groups), dtype=np.int64)
+    for g, members in reversed(list(enumerate(constraints.groups.values()))):
+        labels[np.isin(full_ids, members)] = g
+    return np.unique(labels, return_inverse=True)[1].ravel()
+
+
+def build_deformer(p, opts, cache=None):
+    """The deformer of a :class:`Problem` with resolved settings ``opts``: a
+    :class:`Deformer`, or a :class:`MultiresDeformer` when ``opts["multires"]`` asks for
+    one (``cache``: folder for its coarse meshes)."""
+    common = {"alpha": opts["alpha"], "feedback": opts["feedback"], "weights": opts["weights"],
+              "area": p.area, "method": opts["method"], "sweeps": opts["sweeps"]}
+    size = coarse_size(opts.get("multires"), len(p.V))
+    if size is None:
+        deformer = Deformer(p.V, p.F, p.ids, **common)
+        if opts.get("multires") not in (None, "auto", "off"):
+            deformer.warnings.append(f"multires {opts['multires']} is not below the mesh's "
+                                     f"{len(p.V)} vertices: solved directly")
+        return deformer
+    return MultiresDeformer(p.V, p.F, p.ids, p.labels, size=size, cache=cache, **common)
 
 
 def scatter(mesh, p, positions):
@@ -76,7 +98,7 @@ def scatter(mesh, p, positions):
     return out
 
 
-def deform_mesh(mesh, constraints, callback=None, **overrides):
+def deform_mesh(mesh, constraints, callback=None, cache=None, **overrides):
     """Deform a :class:`~srarap_cli.mesh_io.Mesh` by its :class:`~srarap_cli.handles.Constraints`.
 
     Parameters
@@ -84,7 +106,8 @@ def deform_mesh(mesh, constraints, callback=None, **overrides):
     mesh : Mesh
     constraints : Constraints
     callback : callable(dict), optional, receives each log row
-    **overrides : alpha, feedback, max_iter, tol, weights, method, sweeps
+    cache : str, optional, folder for multiresolution coarse meshes
+    **overrides : alpha, feedback, max_iter, tol, weights, method, sweeps, multires
 
     Returns
     -------
@@ -94,13 +117,13 @@ def deform_mesh(mesh, constraints, callback=None, **overrides):
     """
     opts = settings(constraints.solver, overrides)
     p = problem(mesh, constraints)
-    deformer = build_deformer(p, opts)
+    deformer = build_deformer(p, opts, cache)
     sub_result = deformer.solve(p.targets, max_iter=opts["max_iter"], tol=opts["tol"],
                                 callback=callback)
     positions = scatter(mesh, p, sub_result.positions)
     rotors = np.tile(IDENTITY, (len(positions), 1))
     rotors[p.vertices] = sub_result.rotors
     result = DeformResult(positions, rotors, sub_result.log, sub_result.converged,
-                          sub_result.iterations)
+                          sub_result.iterations, sub_result.full_energy, sub_result.stages, sub_result.coarse)
     notes = mesh_warnings(mesh.vertices, mesh.triangles()[0]) + list(deformer.warnings)
     return mesh.with_vertices(positions), result, notes

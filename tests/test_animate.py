@@ -57,16 +57,18 @@ def test_a_240_degree_twist_is_temporally_coherent(feedback):
         assert jump <= 1.5 * handle + 1e-12
 
 
-def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames():
-    mesh = tube_mesh(rings=6, segments=6)
+@pytest.mark.parametrize("rings, multires", [(6, "off"), (30, 60)])
+def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames(rings, multires):
+    mesh = tube_mesh(rings=rings, segments=6)
     keys = [{"frame": 0}, {"frame": 3, "rotate": {"axis": [1, 1, 0], "angle": 90},
                            "translate": [1, 2, 3]}]
     doc = {"groups": {g: {"box": box, "pivot": [0, 0, 3], "keyframes": keys}
                       for g, box in (("base", BASE["box"]), ("top", TOP_BOX))}}
     c = parse_handles(doc, mesh.vertices)
     frames = []
-    Animator(mesh, c, settings({}, {})).run(4, iters_per_frame=3000, tol=1e-13,
-                                            on_frame=lambda f, P, s: frames.append(P))
+    animator = Animator(mesh, c, settings({}, {"multires": multires}))
+    assert (multires == "off") == (animator.deformer.__class__.__name__ == "Deformer")
+    animator.run(4, iters_per_frame=3000, tol=1e-13, on_frame=lambda f, P, s: frames.append(P))
     q1 = from_axis_angle([1, 1, 0], 90)
     for f, P in enumerate(frames):
         t = f / 3
@@ -75,9 +77,10 @@ def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames():
         assert np.abs(P - expected).max() < 1e-8
 
 
-def test_sequence_is_deterministic_and_resume_after_a_kill_gives_the_same_files(tmp_path):
+@pytest.mark.parametrize("extra", [[], ["--multires", "150"]])
+def test_sequence_is_deterministic_and_resume_after_a_kill_gives_the_same_files(tmp_path, extra):
     ref, cut = tmp_path / "ref", tmp_path / "cut"
-    base = [sys.executable, "-m", "srarap_cli", "animate", BAR, TWIST, "-q"]
+    base = [sys.executable, "-m", "srarap_cli", "animate", BAR, TWIST, "-q", *extra]
     for folder in (ref, tmp_path / "again"):
         subprocess.run(base + ["-o", str(folder / "f_{:03d}.obj"), "--log",
                                str(folder.with_suffix(".csv"))], check=True)

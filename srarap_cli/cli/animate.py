@@ -17,7 +17,7 @@ from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
 from ..pipeline import settings
 from ..solve_log import LOG_FORMATS
-from .common import check_output_path, guarded, solver_options
+from .common import check_output_path, guarded, multires_options, solver_options
 
 STATE_NAME = ".srarap-animate-state.npz"
 
@@ -38,10 +38,11 @@ STATE_NAME = ".srarap-animate-state.npz"
 @click.option("--method", type=click.Choice(tuple(METHODS)),
               help="Local step. [default: sr-linear-sym]")
 @solver_options
+@multires_options
 @click.option("-q", "--quiet", is_flag=True, help="No progress, summary or warnings.")
 @guarded
 def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, method, alpha,
-            feedback, max_iter, tol, weights, sweeps, quiet):
+            feedback, max_iter, tol, weights, sweeps, multires, cache, quiet):
     """Deform MESH through the keyframes of HANDLES, writing one mesh per frame.
 
     Each frame starts from the previous one (positions and rotors) and iterates until --tol or
@@ -58,11 +59,12 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, m
     n_frames = frames or math.floor(constraints.last_key_frame) + 1
     opts = settings(constraints.solver, {"alpha": alpha, "feedback": feedback, "tol": tol,
                                          "weights": weights, "method": method,
-                                         "sweeps": sweeps, "max_iter": max_iter})
+                                         "sweeps": sweeps, "max_iter": max_iter,
+                                         "multires": multires})
     fingerprint = _fingerprint(mesh, handles, opts, n_frames, fps, iters_per_frame, pattern)
     state_path = os.path.join(folder, STATE_NAME)
     state = _resume_state(state_path, fingerprint) if resume else None
-    animator = Animator(source, constraints, opts)
+    animator = Animator(source, constraints, opts, cache=cache)
     progress = _Progress(n_frames, enabled=not quiet and sys.stderr.isatty())
 
     def write_frame(f, positions, st):

@@ -13,6 +13,7 @@ from .. import exit_codes
 from ..deformer import NumericalError
 from ..errors import InputError, OutputError
 from ..global_step import SingularSystemError
+from ..multires.size import AUTO_SIZE, AUTO_THRESHOLD, parse_size
 from ..operators import WEIGHT_KINDS
 
 
@@ -101,6 +102,32 @@ _SOLVER_OPTIONS = [
     click.option("--sweeps", type=click.IntRange(min=1),
                  help="Relaxation sweeps per iteration for sr-relax. [default: 2]"),
 ]
+
+
+def _multires_setting(_ctx, _param, value):
+    if value is None:
+        return None
+    try:
+        return parse_size(value)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+_MULTIRES_OPTIONS = [
+    click.option("--multires", callback=_multires_setting, metavar="N|P%|off|auto",
+                 help="Solve on a simplified mesh of N vertices (or P% of them) and carry the "
+                      f"result to the full mesh. [default: auto = off below "
+                      f"{AUTO_THRESHOLD} vertices, else {AUTO_SIZE}]"),
+    click.option("--cache", type=click.Path(file_okay=False),
+                 help="Folder keeping simplified meshes between runs (multires)."),
+]
+
+
+def multires_options(func):
+    """``--multires`` and ``--cache`` (None: file or default)."""
+    for option in reversed(_MULTIRES_OPTIONS):
+        func = option(func)
+    return func
 
 
 def solver_options(func):

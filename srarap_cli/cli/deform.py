@@ -12,7 +12,7 @@ from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
 from ..pipeline import deform_mesh, settings
 from ..solve_log import LOG_FORMATS, format_log
-from .common import check_output_path, guarded, solver_options
+from .common import check_output_path, guarded, multires_options, solver_options
 from .render import preview_png
 
 
@@ -26,13 +26,14 @@ from .render import preview_png
 @solver_options
 @click.option("--method", type=click.Choice(tuple(METHODS)),
               help="Local step (see README). [default: sr-linear-sym]")
+@multires_options
 @click.option("--preview", help="Also write a PNG: rest and deformed shape, handles coloured.")
 @click.option("--write-distortion", is_flag=True,
               help="Add a per-vertex 'distortion' property to PLY output.")
 @click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
 @guarded
 def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, method, sweeps,
-           preview, write_distortion, quiet):
+           multires, cache, preview, write_distortion, quiet):
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
@@ -52,8 +53,8 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, met
     check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
     overrides = {"alpha": alpha, "feedback": feedback, "max_iter": max_iter, "tol": tol,
-                 "weights": weights, "method": method, "sweeps": sweeps}
-    deformed, result, notes = deform_mesh(source, constraints, **overrides)
+                 "weights": weights, "method": method, "sweeps": sweeps, "multires": multires}
+    deformed, result, notes = deform_mesh(source, constraints, cache=cache, **overrides)
     if write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
@@ -67,6 +68,9 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, met
     if not quiet:
         for note in notes + lost:
             click.echo(f"srarap: warning: {note}", err=True)
+        if result.stages:
+            click.echo(f"srarap: multires: {stage_summary(result, len(source.vertices))}",
+                       err=True)
         click.echo(_summary(result, settings(constraints.solver, overrides), out), err=True)
     if not result.converged:
         raise SystemExit(exit_codes.NOT_CONVERGED)
@@ -77,6 +81,18 @@ def _summary(result, opts, out):
     state = (f"converged in {result.iterations} iterations" if result.converged else
              f"NOT converged after {result.iterations} iterations "
              f"(relative change {last['rel_change']:.3g} > tol {opts['tol']:g})")
-    return (f"srarap deform: {state}; energy {last['total']:.6g} (membrane "
-            f"{last['membrane']:.6g}, bending {last['bending']:.6g}); {last['seconds']:.2f} s; "
+    e = result.energies()
+    where = "" if result.full_energy is None else f"coarse energy {last['total']:.6g}; full "
+    return (f"srarap deform: {state}; {where}energy {e['total']:.6g} (membrane "
+            f"{e['membrane']:.6g}, bending {e['bending']:.6g}); "
+            f"{sum(result.stages.values()) if result.stages else last['seconds']:.2f} s; "
             f"wrote {out}")
+
+
+def stage_summary(result, n):
+    """One line: coarse size and seconds per multiresolution stage."""
+    names = {"simplify": "simplify", "coarse_precompute": "coarse setup", "factor": "fine factor",
+             "coarse_solve": "coarse solve", "transfer": "transfer", "fine_solve": "fine solve"}
+    cached = " (coarse mesh from cache)" if result.coarse["cache_hit"] else ""
+    times = ", ".join(f"{names.get(k, k)} {v:.2f} s" for k, v in result.stages.items())
+    return f"{result.coarse['vertices']} of {n} vertices{cached}; {times}"

@@ -13,6 +13,7 @@ import yaml
 
 from ..errors import InputError
 from ..local_step import METHODS
+from ..multires.size import parse_size
 from ..operators import WEIGHT_KINDS
 from .fields import Context
 from .formats import read_def, read_sel
@@ -20,7 +21,8 @@ from .keys import parse_track
 from .selectors import SELECTOR_KEYS, select
 from .transforms import ACTION_KEYS, targets
 
-SOLVER_KEYS = ("alpha", "feedback", "max_iter", "tol", "weights", "method", "sweeps")
+SOLVER_KEYS = ("alpha", "feedback", "max_iter", "tol", "weights", "method", "sweeps",
+               "multires")
 TOP_KEYS = ("groups", "region", "solver")
 ANIMATION_KEYS = ("keyframes", "easing")
 
@@ -183,6 +185,11 @@ def _solver(ctx, spec):
         out["method"] = spec["method"]
     if "sweeps" in spec:
         out["sweeps"] = ctx.integer(spec["sweeps"], "sweeps", 1)
+    if "multires" in spec:
+        try:
+            out["multires"] = parse_size(spec["multires"])
+        except ValueError as exc:
+            raise ctx.error(f"multires {exc}") from None
     return out
 
 

@@ -1,0 +1,192 @@
+"""Multiresolution: subset simplification, rotor transfer, the full path, cache and CLI."""
+import os
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from helpers import ROOT, SHARED, random_rotation
+
+from srarap_cli.cli import main
+from srarap_cli.handles import load_handles
+from srarap_cli.mesh_io import read_mesh
+from srarap_cli.multires import (
+    MultiresDeformer,
+    coarse_size,
+    parse_size,
+    simplify_to_subset,
+)
+from srarap_cli.multires.cache import coarse_mesh
+from srarap_cli.multires.dirichlet import DirichletSolver
+from srarap_cli.multires.topology import topology_summary
+from srarap_cli.multires.transfer import group_rotors, spread_rotors
+from srarap_cli.operators import cell_graph, mesh_area
+from srarap_cli.pipeline import problem
+from srarap_cli.quaternion import rotate, to_matrix
+
+SPOT = os.path.join(ROOT, "sample_meshes", "spot.obj")
+NOD = os.path.join(ROOT, "configs", "spot-nod.yaml")
+
+
+@pytest.fixture(scope="module")
+def spot():
+    mesh = read_mesh(SPOT)
+    return mesh.vertices, mesh.triangles()[0]
+
+
+def test_coarse_vertices_are_fine_vertices_and_span_the_same_surface(spot):
+    V, F = spot
+    c = simplify_to_subset(V, F, 800)
+    assert 700 <= len(c.vertices) <= 900
+    assert np.all(np.diff(c.vertices) > 0) and c.vertices[0] >= 0 and c.vertices[-1] < len(V)
+    assert c.faces.min() >= 0 and c.faces.max() == len(c.vertices) - 1
+    coarse_V = V[c.vertices]
+    # a triangulation of those very points: same area within a few percent, no collapsed face
+    assert abs(mesh_area(coarse_V, c.faces) / mesh_area(V, F) - 1) < 0.05
+    assert np.all(np.ptp(c.faces, axis=1) > 0)
+    assert c.warnings == []
+
+
+@pytest.mark.parametrize("name, genus_euler, loops", [("torus.obj", 0, 0),
+                                                     ("hand_lowres.obj", 1, 1)])
+def test_simplification_keeps_manifoldness_genus_and_boundaries(name, genus_euler, loops):
+    mesh = read_mesh(os.path.join(SHARED, name))
+    F = mesh.triangles()[0]
+    c = simplify_to_subset(mesh.vertices, F, len(mesh.vertices) // 8)
+    fine, coarse = topology_summary(F, len(mesh.vertices)), topology_summary(c.faces,
+                                                                             len(c.vertices))
+    assert fine["euler"] == coarse["euler"] == genus_euler
+    assert fine["boundary_loops"] == coarse["boundary_loops"] == loops
+    assert coarse["edge_manifold"] and coarse["components"] == 1
+    assert len(c.vertices) < len(mesh.vertices) // 4
+
+
+def test_every_handle_group_keeps_a_coarse_vertex(spot):
+    V, F = spot
+    rng = np.random.default_rng(3)
+    groups = [np.array([i]) for i in rng.choice(len(V), 12, replace=False)]
+    plain = simplify_to_subset(V, F, 300)
+    dropped = sum(not np.isin(g, plain.vertices).any() for g in groups)
+    assert dropped >= 6  # so the protected second pass is what keeps them
+    c = simplify_to_subset(V, F, 300, groups)
+    assert all(np.isin(g, c.vertices).any() for g in groups)
+    assert len(c.vertices) < 600
+    assert topology_summary(c.faces, len(c.vertices))["euler"] == 2
+
+
+def test_harmonic_transfer_reproduces_a_constant_rotor_field_exactly(spot):
+    V, F = spot
+    graph = cell_graph(V, F)
+    known = simplify_to_subset(V, F, 500).vertices
+    q = np.array([0.5, -0.5, 0.5, 0.5])
+    R = spread_rotors(DirichletSolver(graph.laplacian, known), np.tile(q, (len(known), 1)))
+    assert np.abs(R - q).max() < 1e-12
+
+
+def test_harmonic_transfer_is_the_laplace_solution_between_known_rotors(spot):
+    V, F = spot
+    graph = cell_graph(V, F)
+    known = simplify_to_subset(V, F, 500).vertices
+    rng = np.random.default_rng(0)
+    values = np.abs(rng.normal(size=(len(known), 4))) + 0.1
+    raw = DirichletSolver(graph.laplacian, known).solve(values)
+    free = np.setdiff1d(np.arange(len(V)), known)
+    assert np.abs((graph.laplacian @ raw)[free]).max() < 1e-10 * np.abs(values).max()
+    assert np.array_equal(raw[known], values)
+
+
+def test_group_rotors_recover_each_groups_rotation_and_flag_collinear_groups():
+    rng = np.random.default_rng(1)
+    rest = rng.normal(size=(12, 3))
+    rest[8:] = np.outer(np.arange(4.0), [1, 2, 3])  # a collinear group
+    labels = np.repeat([0, 1, 2], 4)
+    q = np.array([random_rotation(rng) for _ in range(3)])
+    moved = rotate(q[labels], rest) + rng.normal(size=3)
+    R, ok = group_rotors(rest, moved, labels, 3)
+    sign = np.sign(np.sum(R * q[labels], axis=1, keepdims=True))
+    assert np.abs(R * sign - q[labels])[:8].max() < 1e-12
+    assert ok.tolist() == [True] * 8 + [False] * 4
+
+
+def test_rigid_motion_of_all_handles_is_reproduced_exactly_through_multires(spot):
+    V = spot[0]
+    c = load_handles(NOD, V)
+    p = problem(read_mesh(SPOT), c)
+    q = np.array([0.8, 0.2, -0.4, 0.4]) / np.linalg.norm([0.8, 0.2, -0.4, 0.4])
+    t = np.array([0.3, -2.0, 1.5])
+    d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=250)
+    assert d.n_groups == 2 and all(np.isin(g, d.coarse.vertices).any()
+                                   for g in (c.groups["hooves"], c.groups["head"]))
+    r = d.solve(p.V[p.ids] @ to_matrix(q[None])[0].T + t, max_iter=3000, tol=1e-13)
+    expect = V @ to_matrix(q[None])[0].T + t
+    diag = np.linalg.norm(np.ptp(V, axis=0))
+    assert np.abs(r.positions - expect).max() < 1e-8 * diag
+    assert np.abs(np.abs(r.rotors @ q) - 1).max() < 1e-9
+    assert r.full_energy["total"] < 1e-12
+
+
+def test_multires_solve_follows_the_handles_and_logs_its_stages(spot):
+    V = spot[0]
+    c = load_handles(NOD, V)
+    p = problem(read_mesh(SPOT), c)
+    d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500)
+    r = d.solve(p.targets, max_iter=400)
+    assert np.array_equal(r.positions[p.ids], p.targets)
+    assert set(r.stages) == {"simplify", "coarse_precompute", "factor", "coarse_solve",
+                             "transfer", "fine_solve"}
+    assert np.allclose(np.linalg.norm(r.rotors, axis=1), 1)
+    # the coarse solution is kept exactly at the coarse vertices
+    coarse_positions = d.coarse_deformer.solve(p.targets[d._coarse_slots], max_iter=400).positions
+    assert np.array_equal(r.positions[d.coarse.vertices], coarse_positions)
+
+
+def test_cache_is_keyed_by_mesh_and_constraint_set_and_survives_corruption(spot, tmp_path):
+    V, F = spot
+    groups = [np.array([0, 1, 2])]
+    first, hit, notes = coarse_mesh(V, F, 400, groups, str(tmp_path))
+    assert not hit and notes == [] and len(os.listdir(tmp_path)) == 1
+    again, hit, _ = coarse_mesh(V, F, 400, groups, str(tmp_path))
+    assert hit and np.array_equal(again.vertices, first.vertices)
+    assert np.array_equal(again.faces, first.faces)
+    _, hit, _ = coarse_mesh(V, F, 400, [np.array([0, 1, 5])], str(tmp_path))
+    assert not hit and len(os.listdir(tmp_path)) == 2
+    (entry,) = [f for f in os.listdir(tmp_path) if f.endswith(".npz")][:1]
+    for name in os.listdir(tmp_path):
+        (tmp_path / name).write_bytes(b"not a cache entry")
+    fresh, hit, notes = coarse_mesh(V, F, 400, groups, str(tmp_path))
+    assert not hit and "unreadable cache entry" in notes[0]
+    assert np.array_equal(fresh.vertices, first.vertices)
+    assert entry
+
+
+def test_multires_settings_parse_and_pick_the_direct_solve_for_small_meshes():
+    assert parse_size("2%") == 0.02 and parse_size(5000) == 5000 and parse_size("OFF") == "off"
+    for bad in ("0%", "100%", "3", "many", True, "-5"):
+        with pytest.raises(ValueError):
+            parse_size(bad)
+    assert coarse_size("auto", 199_999) is None and coarse_size("auto", 800_000) == 20_000
+    assert coarse_size(0.02, 100_000) == 2000 and coarse_size(5000, 4000) is None
+    assert coarse_size("off", 10**7) is None
+
+
+def test_cli_multires_runs_caches_and_gives_identical_files(tmp_path):
+    runner = CliRunner()
+    args = ["deform", SPOT, NOD, "--multires", "1000", "--cache", str(tmp_path / "cache"),
+            "--max-iter", "40"]
+    one = runner.invoke(main, args + ["-o", str(tmp_path / "a.obj")])
+    assert one.exit_code in (0, 3), one.output
+    assert "srarap: multires: " in one.output and "full energy" in one.output
+    two = runner.invoke(main, args + ["-o", str(tmp_path / "b.obj")])
+    assert "coarse mesh from cache" in two.output
+    assert (tmp_path / "a.obj").read_bytes() == (tmp_path / "b.obj").read_bytes()
+
+
+def test_cli_rejects_a_bad_multires_value_in_options_and_in_the_handle_file(tmp_path):
+    runner = CliRunner()
+    out = runner.invoke(main, ["deform", SPOT, NOD, "--multires", "2", "-o",
+                               str(tmp_path / "a.obj")])
+    assert out.exit_code == 2 and "at least 4" in out.output
+    handles = tmp_path / "h.yaml"
+    handles.write_text("solver: {multires: lots}\ngroups: {a: {indices: [0], fixed: true}}\n")
+    out = runner.invoke(main, ["deform", SPOT, str(handles), "-o", str(tmp_path / "a.obj")])
+    assert out.exit_code == 4 and "multires must be off" in out.output
+    assert not (tmp_path / "a.obj").exists()
