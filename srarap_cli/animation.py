@@ -75,7 +75,8 @@ class Animator:
             P, R, rows, first = state.positions, state.rotors, list(state.rows), state.frame + 1
         for f in range(first, frames):
             start = time.perf_counter()
-            targets = self.problem.targets_for(self.constraints.targets_at(float(f)))
+            frame_targets = self.constraints.targets_at(float(f))
+            targets = self.problem.targets_for(frame_targets)
             result = self.deformer.solve(targets, max_iter=iters_per_frame, tol=tol,
                                          initial=None if P is None else (P, R))
             # the solver's own rotors against the previous frame's: negative means a sign flip
@@ -89,5 +90,6 @@ class Animator:
                          "min_rotor_dot": dot, "seconds": time.perf_counter() - start})
             state = FrameState(f, P, R, list(rows), fingerprint)
             if on_frame is not None:
-                on_frame(f, scatter(self.mesh, self.problem, P), state)
+                on_frame(f, scatter(self.mesh, self.problem, P, self.constraints, frame_targets),
+                         state)
         return state

@@ -39,8 +39,8 @@ class DeformResult:
         ``membrane``, ``bending``, ``total`` of the returned positions and rotors when they
         differ from the last log row (multiresolution: the log follows the coarse mesh)
     stages : dict, seconds per stage of a multiresolution solve (empty otherwise)
-    coarse : dict or None, multiresolution only: ``vertices`` (coarse count) and
-        ``cache_hit`` (the coarse mesh came from the cache)
+    coarse : dict or None, multiresolution only: ``vertices`` (coarse count), ``of`` (the
+        solved mesh's count) and ``cache_hit`` (the coarse mesh came from the cache)
     """
 
     positions: np.ndarray

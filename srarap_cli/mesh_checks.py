@@ -10,6 +10,26 @@ def solvable_faces(F):
     return F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
 
 
+def unique_rows(a):
+    """Distinct rows of an int array (m, k) in lexicographic order, and how often each occurs.
+
+    Same result as ``np.unique(a, axis=0, return_counts=True)``, several times faster on
+    millions of rows (no structured-dtype sort).
+
+    Examples
+    --------
+    >>> rows, counts = unique_rows(np.array([[1, 2], [0, 5], [1, 2]]))
+    >>> rows.tolist(), counts.tolist()
+    ([[0, 5], [1, 2]], [1, 2])
+    """
+    a = np.asarray(a)
+    if len(a) == 0:
+        return a.reshape(0, a.shape[1] if a.ndim == 2 else 0), np.zeros(0, dtype=np.int64)
+    s = a[np.lexsort(a.T[::-1])]
+    start = np.flatnonzero(np.concatenate([[True], np.any(s[1:] != s[:-1], axis=1)]))
+    return s[start], np.diff(np.append(start, len(s)))
+
+
 def mesh_warnings(V, F):
     """Warning lines for duplicate faces, collapsed, zero-area and needle triangles, and
     non-manifold edges and vertices of a triangle mesh (V (n, 3), F (f, 3)).
@@ -25,8 +45,8 @@ def mesh_warnings(V, F):
     if collapsed:
         out.append(f"{collapsed} faces repeat a vertex; left out of the solve")
     F = solvable_faces(F)
-    keys = np.sort(F, axis=1)
-    duplicates = len(F) - len(np.unique(keys, axis=0))
+    distinct = unique_rows(np.sort(F, axis=1))[0]
+    duplicates = len(F) - len(distinct)
     if duplicates:
         out.append(f"{duplicates} duplicate faces (same vertices as another face)")
     scale = float(np.ptp(V, axis=0).max()) ** 2 if len(V) else 0.0
@@ -40,14 +60,14 @@ def mesh_warnings(V, F):
     if needles:
         out.append(f"{needles} needle faces (an angle under {NEEDLE_DEGREES:g} degree); "
                    "cotangents are capped at 1000 so no edge weight can swamp the others")
-    out.extend(_manifold_warnings(np.unique(keys, axis=0), len(V)))  # duplicates said above
+    out.extend(_manifold_warnings(distinct, len(V)))  # duplicates said above
     return out
 
 
 def _manifold_warnings(F, n):
     out = []
     edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    _, counts = np.unique(edges, axis=0, return_counts=True)
+    counts = unique_rows(edges)[1]
     if (counts > 2).any():
         out.append(f"{int((counts > 2).sum())} non-manifold edges (more than two faces); solved, "
                    "the operators are defined there")

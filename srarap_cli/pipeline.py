@@ -91,10 +91,13 @@ def build_deformer(p, opts, cache=None):
     return MultiresDeformer(p.V, p.F, p.ids, p.labels, size=size, cache=cache, **common)
 
 
-def scatter(mesh, p, positions):
-    """Full-mesh positions from a problem's solved positions."""
+def scatter(mesh, p, positions, constraints, constraint_targets=None):
+    """Full-mesh positions from a problem's solved positions. Constrained vertices go to their
+    targets even where a region of interest left them out of the solve (handle vertices
+    whose triangles touch no movable vertex)."""
     out = mesh.vertices.copy()
     out[p.vertices] = positions
+    out[constraints.ids] = constraints.targets if constraint_targets is None else constraint_targets
     return out
 
 
@@ -120,7 +123,7 @@ def deform_mesh(mesh, constraints, callback=None, cache=None, **overrides):
     deformer = build_deformer(p, opts, cache)
     sub_result = deformer.solve(p.targets, max_iter=opts["max_iter"], tol=opts["tol"],
                                 callback=callback)
-    positions = scatter(mesh, p, sub_result.positions)
+    positions = scatter(mesh, p, sub_result.positions, constraints)
     rotors = np.tile(IDENTITY, (len(positions), 1))
     rotors[p.vertices] = sub_result.rotors
     result = DeformResult(positions, rotors, sub_result.log, sub_result.converged,

@@ -163,7 +163,7 @@ def test_multires_settings_parse_and_pick_the_direct_solve_for_small_meshes():
     for bad in ("0%", "100%", "3", "many", True, "-5"):
         with pytest.raises(ValueError):
             parse_size(bad)
-    assert coarse_size("auto", 199_999) is None and coarse_size("auto", 800_000) == 20_000
+    assert coarse_size("auto", 99_999) is None and coarse_size("auto", 800_000) == 5_000
     assert coarse_size(0.02, 100_000) == 2000 and coarse_size(5000, 4000) is None
     assert coarse_size("off", 10**7) is None
 
@@ -190,3 +190,24 @@ def test_cli_rejects_a_bad_multires_value_in_options_and_in_the_handle_file(tmp_
     out = runner.invoke(main, ["deform", SPOT, str(handles), "-o", str(tmp_path / "a.obj")])
     assert out.exit_code == 4 and "multires must be off" in out.output
     assert not (tmp_path / "a.obj").exists()
+
+
+@pytest.mark.parametrize("multires", ["off", "400"])
+def test_region_of_interest_moves_every_handle_vertex_and_nothing_outside(tmp_path, multires):
+    """Head vertices whose triangles touch no movable vertex are outside the solve; they must
+    still reach their targets (they once stayed at rest)."""
+    doc = tmp_path / "h.yaml"
+    doc.write_text(
+        "region: {sphere: {center: [0, 0.4, -0.5], radius: 0.6}}\n"
+        "groups:\n"
+        "  head: {sphere: {center: [0, 0.55, -0.5], radius: 0.3}, translate: [0, 0.1, 0]}\n")
+    out = tmp_path / "out.obj"
+    r = CliRunner().invoke(main, ["deform", SPOT, str(doc), "-o", str(out), "--multires", multires,
+                                  "--max-iter", "100"])
+    assert r.exit_code in (0, 3), r.output
+    rest, moved = read_mesh(SPOT).vertices, read_mesh(str(out)).vertices
+    c = load_handles(str(doc), rest)
+    outside = np.setdiff1d(np.arange(len(rest)), c.region)
+    assert np.array_equal(moved[outside], rest[outside])
+    assert np.abs(moved[c.ids] - c.targets).max() < 1e-12
+    assert np.abs(moved[c.region] - rest[c.region]).max() > 0.05

@@ -15,6 +15,7 @@ from ..limits import check_solve
 from ..local_step import METHODS
 from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
+from ..multires import MultiresDeformer
 from ..pipeline import settings
 from ..solve_log import LOG_FORMATS
 from .common import check_output_path, guarded, multires_options, solver_options
@@ -80,6 +81,11 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, m
         commit_files([(log, _log_text(rows, os.path.splitext(log)[1].lower()).encode())])
     os.unlink(state_path) if os.path.exists(state_path) else None
     if not quiet:
+        d = animator.deformer
+        if isinstance(d, MultiresDeformer):
+            setup = ", ".join(f"{k} {v:.2f} s" for k, v in d.stages.items())
+            click.echo(f"srarap: multires: {len(d.coarse.vertices)} of {len(d.V)} vertices; "
+                       f"{setup}", err=True)
         stalled = sum(not r["converged"] for r in rows)
         seconds = sum(r["seconds"] for r in rows)
         click.echo(f"srarap animate: {len(rows)} frames ({stalled} stopped at "

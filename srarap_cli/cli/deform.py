@@ -69,8 +69,7 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, met
         for note in notes + lost:
             click.echo(f"srarap: warning: {note}", err=True)
         if result.stages:
-            click.echo(f"srarap: multires: {stage_summary(result, len(source.vertices))}",
-                       err=True)
+            click.echo(f"srarap: multires: {stage_summary(result)}", err=True)
         click.echo(_summary(result, settings(constraints.solver, overrides), out), err=True)
     if not result.converged:
         raise SystemExit(exit_codes.NOT_CONVERGED)
@@ -89,10 +88,10 @@ def _summary(result, opts, out):
             f"wrote {out}")
 
 
-def stage_summary(result, n):
+def stage_summary(result):
     """One line: coarse size and seconds per multiresolution stage."""
-    names = {"simplify": "simplify", "coarse_precompute": "coarse setup", "factor": "fine factor",
+    names = {"simplify": "simplify", "coarse_precompute": "coarse setup", "factor": "fine setup",
              "coarse_solve": "coarse solve", "transfer": "transfer", "fine_solve": "fine solve"}
     cached = " (coarse mesh from cache)" if result.coarse["cache_hit"] else ""
     times = ", ".join(f"{names.get(k, k)} {v:.2f} s" for k, v in result.stages.items())
-    return f"{result.coarse['vertices']} of {n} vertices{cached}; {times}"
+    return f"{result.coarse['vertices']} of {result.coarse['of']} vertices{cached}; {times}"

@@ -34,7 +34,7 @@ def _corner(token, counts, path, lineno):
 
 def read_obj(path):
     """Read an OBJ file into a :class:`Mesh`, keeping vertex and face order."""
-    verts, uvs, norms, sizes, corners, statements = [], [], [], [], [], []
+    verts, uvs, norms, sizes, faces, statements = [], [], [], [], [], []
     with open(path, encoding="utf-8", errors="replace") as fh:
         text = fh.read().replace("\\\n", " ")
     for lineno, raw in enumerate(text.splitlines(), 1):
@@ -49,16 +49,15 @@ def read_obj(path):
         elif head == "vn":
             norms.append(rest.split())
         elif head == "f":
-            tokens = rest.split()
-            if len(tokens) < 3:
+            size = len(rest.split())
+            if size < 3:
                 raise InputError(f"{path}:{lineno}: face with fewer than 3 corners")
-            counts = (len(verts), len(uvs), len(norms))
-            corners.extend(_corner(t, counts, path, lineno) for t in tokens)
-            sizes.append(len(tokens))
+            faces.append((lineno, rest, (len(verts), len(uvs), len(norms))))
+            sizes.append(size)
         else:
             statements.append((len(sizes), line))
     V = _floats(verts, 3, path, "v")
-    c = np.array(corners, dtype=np.int64).reshape(-1, 3)
+    c = _face_corners(faces, path)
     mesh = Mesh(vertices=V, face_sizes=np.array(sizes, dtype=np.int64),
                 face_vertices=c[:, 0].copy(), statements=statements)
     if uvs and (c[:, 1] >= 0).any():
@@ -69,6 +68,20 @@ def read_obj(path):
     _check_refs(mesh.face_uv, 0 if mesh.uv is None else len(mesh.uv), path, "vt")
     _check_refs(mesh.face_normals, 0 if mesh.normals is None else len(mesh.normals), path, "vn")
     return mesh
+
+
+def _face_corners(faces, path):
+    """(corners, 3) ids: vertex, uv, normal (-1 when absent). Plain positive vertex indices
+    (most large files) are parsed in one go; anything else corner by corner."""
+    try:
+        v = np.array(" ".join(rest for _, rest, _ in faces).split(), dtype=np.int64)
+        if v.size and v.min() >= 1:
+            return np.column_stack([v - 1, np.full(v.size, -1), np.full(v.size, -1)])
+    except ValueError:
+        pass
+    corners = [_corner(t, counts, path, lineno)
+               for lineno, rest, counts in faces for t in rest.split()]
+    return np.array(corners, dtype=np.int64).reshape(-1, 3)
 
 
 def _check_refs(refs, count, path, what):

@@ -59,7 +59,6 @@ class MultiresDeformer:
         start = time.perf_counter()
         self.V = np.asarray(V, dtype=float)
         self.F = np.asarray(F, dtype=np.int64)
-        n = len(self.V)
         self.constrained = np.asarray(constrained, dtype=np.int64).ravel()
         k = self.constrained.size
         self.labels = np.zeros(k, np.int64) if labels is None else np.asarray(labels, np.int64)
@@ -67,34 +66,42 @@ class MultiresDeformer:
         groups = [self.constrained[self.labels == g] for g in range(self.n_groups)]
         self.coarse, self.cache_hit, notes = coarse_mesh(self.V, self.F, size, groups, cache)
         self.stages = {"simplify": time.perf_counter() - start}
-        cv = self.coarse.vertices
-        slot = np.full(n, -1)
-        slot[self.constrained] = np.arange(k)
-        in_coarse = slot[cv] >= 0
-        self._coarse_slots = slot[cv][in_coarse]
-        weights = options.get("weights", "cotan-clamped")
-        self.graph = cell_graph(self.V, self.F, weights)
+        mark = time.perf_counter()
+        self.graph = cell_graph(self.V, self.F, options.get("weights", "cotan-clamped"))
         self.area = self.graph.area if area is None else float(area)
         self.alpha = float(options.get("alpha", 0.14))
-        mark = time.perf_counter()
-        self.coarse_deformer = Deformer(self.V[cv], self.coarse.faces, np.flatnonzero(in_coarse),
-                                        area=self.area, **options)
-        self.stages["coarse_precompute"] = time.perf_counter() - mark
-        mark = time.perf_counter()
-        known = np.zeros(n, dtype=bool)
-        known[cv] = True
-        known[self.constrained] = True
-        self.auto_fixed, fixed_notes = unanchored(self.graph, known)
-        known[self.auto_fixed] = True
-        self._known = np.flatnonzero(known)
-        self._row = np.full(n, -1)
-        self._row[self._known] = np.arange(self._known.size)
-        self.edges = RestEdges(self.graph, self.V)
-        self.solver = DirichletSolver(self.graph.laplacian, self._known)
-        self.stages["factor"] = time.perf_counter() - mark
+        self._build_coarse(options)
+        fixed_notes = self._build_fine()
+        self.stages["factor"] = (time.perf_counter() - mark
+                                 - self.stages["coarse_precompute"])
         self._bending_alpha = self.alpha if self.coarse_deformer.local_step.bending else 0.0
         self.warnings = (weight_warnings(self.graph) + fixed_notes + notes
                          + [f"multires: {w}" for w in self.coarse.warnings])
+
+    def _build_coarse(self, options):
+        start = time.perf_counter()
+        cv = self.coarse.vertices
+        slot = np.full(len(self.V), -1)
+        slot[self.constrained] = np.arange(self.constrained.size)
+        in_coarse = slot[cv] >= 0
+        self._coarse_slots = slot[cv][in_coarse]
+        self.coarse_deformer = Deformer(self.V[cv], self.coarse.faces, np.flatnonzero(in_coarse),
+                                        area=self.area, **options)
+        self.stages["coarse_precompute"] = time.perf_counter() - start
+
+    def _build_fine(self):
+        """Dirichlet set (coarse, constrained and immovable vertices) and its factorization."""
+        known = np.zeros(len(self.V), dtype=bool)
+        known[self.coarse.vertices] = True
+        known[self.constrained] = True
+        self.auto_fixed, notes = unanchored(self.graph, known)
+        known[self.auto_fixed] = True
+        self._known = np.flatnonzero(known)
+        self._row = np.full(len(self.V), -1)
+        self._row[self._known] = np.arange(self._known.size)
+        self.edges = RestEdges(self.graph, self.V)
+        self.solver = DirichletSolver(self.graph.laplacian, self._known)
+        return notes
 
     def solve(self, targets, *, max_iter=200, tol=1e-6, initial=None, callback=None,
               time_limit=None):
@@ -123,7 +130,8 @@ class MultiresDeformer:
         return DeformResult(P, R, coarse.log, coarse.converged, coarse.iterations,
                             full_energy={"membrane": membrane, "bending": bending,
                                          "total": membrane + bending}, stages=stages,
-                            coarse={"vertices": int(cv.size), "cache_hit": self.cache_hit})
+                            coarse={"vertices": int(cv.size), "of": len(self.V),
+                                    "cache_hit": self.cache_hit})
 
     def _known_rotors(self, targets, coarse_rotors):
         out = np.tile(IDENTITY, (self._known.size, 1))

@@ -3,6 +3,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse import csgraph
 
+from ..mesh_checks import unique_rows
+
 
 def topology_summary(F, n):
     """Counts that a genus-preserving simplification must keep.
@@ -25,7 +27,7 @@ def topology_summary(F, n):
     """
     F = np.asarray(F, dtype=np.int64)
     half = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    edges, count = np.unique(half, axis=0, return_counts=True)
+    edges, count = unique_rows(half)
     used = np.unique(F)
     adj = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
     components = csgraph.connected_components(adj, directed=False)[1][used]
