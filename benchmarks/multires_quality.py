@@ -11,10 +11,12 @@ Run: python benchmarks/make_big_spot.py out/spot-46k.obj --levels 1
 """
 import argparse
 import json
+import os
 import time
 
 import numpy as np
 
+from srarap_cli.deformer import DeformResult
 from srarap_cli.energy import bending_energy, membrane_energy
 from srarap_cli.handles import load_handles
 from srarap_cli.mesh_io import read_mesh
@@ -36,6 +38,21 @@ def run(p, opts, size, tol, max_iter):
     return d, r, time.perf_counter() - start
 
 
+def reference(p, opts, args):
+    """The direct solve: computed, or read from ``args.reference`` (same inputs assumed)."""
+    if args.reference and os.path.exists(args.reference):
+        direct = build_deformer(p, dict(opts, multires="off"))
+        with np.load(args.reference) as z:
+            log = json.loads(str(z["log"]))
+            ref = DeformResult(z["positions"], z["rotors"], log, True, len(log) - 1)
+            return direct, ref, float(z["seconds"])
+    direct, ref, seconds = run(p, opts, "off", args.tol, args.max_iter)
+    if args.reference:
+        np.savez(args.reference, positions=ref.positions, rotors=ref.rotors,
+                 log=json.dumps(ref.log), seconds=seconds)
+    return direct, ref, seconds
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("mesh")
@@ -44,12 +61,14 @@ def main():
     ap.add_argument("--tol", type=float, default=1e-6)
     ap.add_argument("--max-iter", type=int, default=5000)
     ap.add_argument("--json")
+    ap.add_argument("--reference", help="npz keeping the direct solve between runs (it takes "
+                    "long); reused when it exists")
     args = ap.parse_args()
     mesh = read_mesh(args.mesh)
     c = load_handles(args.handles, mesh.vertices)
     p = problem(mesh, c)
     opts = settings(c.solver, {})
-    direct, ref, direct_s = run(p, opts, "off", args.tol, args.max_iter)
+    direct, ref, direct_s = reference(p, opts, args)
     diag = float(np.linalg.norm(np.ptp(p.V, axis=0)))
     e_ref = ref.energy
     rows = [{"coarse": len(p.V), "seconds": direct_s, "iterations": ref.iterations,

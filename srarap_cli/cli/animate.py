@@ -18,7 +18,13 @@ from ..mesh_io.commit import commit_files
 from ..multires import MultiresDeformer
 from ..pipeline import settings
 from ..solve_log import LOG_FORMATS
-from .common import check_output_path, guarded, multires_options, solver_options
+from .common import (
+    check_output_path,
+    guarded,
+    multires_options,
+    solver_options,
+    stage_text,
+)
 
 STATE_NAME = ".srarap-animate-state.npz"
 
@@ -83,9 +89,8 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, m
     if not quiet:
         d = animator.deformer
         if isinstance(d, MultiresDeformer):
-            setup = ", ".join(f"{k} {v:.2f} s" for k, v in d.stages.items())
             click.echo(f"srarap: multires: {len(d.coarse.vertices)} of {len(d.V)} vertices; "
-                       f"{setup}", err=True)
+                       f"{stage_text(d.stages)}", err=True)
         stalled = sum(not r["converged"] for r in rows)
         seconds = sum(r["seconds"] for r in rows)
         click.echo(f"srarap animate: {len(rows)} frames ({stalled} stopped at "

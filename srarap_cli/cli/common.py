@@ -16,6 +16,15 @@ from ..global_step import SingularSystemError
 from ..multires.size import AUTO_SIZE, AUTO_THRESHOLD, parse_size
 from ..operators import WEIGHT_KINDS
 
+STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
+               "factor": "fine setup", "coarse_solve": "coarse solve", "transfer": "transfer",
+               "fine_solve": "fine solve"}
+
+
+def stage_text(stages):
+    """``simplify 1.20 s, coarse setup 0.10 s, ...`` for a dict of stage seconds."""
+    return ", ".join(f"{STAGE_NAMES.get(k, k)} {v:.2f} s" for k, v in stages.items())
+
 
 def fail(code, message):
     click.echo(f"srarap: error: {message}", err=True)

@@ -12,7 +12,13 @@ from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
 from ..pipeline import deform_mesh, settings
 from ..solve_log import LOG_FORMATS, format_log
-from .common import check_output_path, guarded, multires_options, solver_options
+from .common import (
+    check_output_path,
+    guarded,
+    multires_options,
+    solver_options,
+    stage_text,
+)
 from .render import preview_png
 
 
@@ -90,8 +96,6 @@ def _summary(result, opts, out):
 
 def stage_summary(result):
     """One line: coarse size and seconds per multiresolution stage."""
-    names = {"simplify": "simplify", "coarse_precompute": "coarse setup", "factor": "fine setup",
-             "coarse_solve": "coarse solve", "transfer": "transfer", "fine_solve": "fine solve"}
     cached = " (coarse mesh from cache)" if result.coarse["cache_hit"] else ""
-    times = ", ".join(f"{names.get(k, k)} {v:.2f} s" for k, v in result.stages.items())
+    times = stage_text(result.stages)
     return f"{result.coarse['vertices']} of {result.coarse['of']} vertices{cached}; {times}"

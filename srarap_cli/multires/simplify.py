@@ -3,7 +3,10 @@
 MeshLab's quadric edge collapse (through pymeshlab) with optimal placement off moves every
 collapsed edge onto one of its two endpoints, so each coarse vertex sits exactly on a fine
 vertex: the coarse-to-fine map is exact, never a nearest-vertex guess. It is the tool the
-paper's reference implementation used for its coarse meshes.
+paper's reference implementation used for its coarse meshes. Its planar quadric keeps flat
+regions from collapsing into slivers: on a 50k-vertex faceted bar simplified to 5,000
+vertices, triangles with an angle under 5 degrees drop from 1245 to 60 (no change on the
+smooth cow), and the coarse solve's iterations get cheaper.
 """
 from dataclasses import dataclass
 
@@ -92,7 +95,7 @@ def _decimate(V, F, size, used, keep):
     target = max(4, round(size * len(F) / max(int(used.sum()), 1)))
     ms.meshing_decimation_quadric_edge_collapse(
         targetfacenum=target, optimalplacement=False, preservetopology=True,
-        preserveboundary=True, autoclean=True, selected=keep is not None)
+        preserveboundary=True, planarquadric=True, autoclean=True, selected=keep is not None)
     out = ms.current_mesh()
     ids = _fine_ids(V, out.vertex_matrix(), out.vertex_scalar_array())
     order = np.argsort(ids)
