@@ -211,3 +211,15 @@ def test_region_of_interest_moves_every_handle_vertex_and_nothing_outside(tmp_pa
     assert np.array_equal(moved[outside], rest[outside])
     assert np.abs(moved[c.ids] - c.targets).max() < 1e-12
     assert np.abs(moved[c.region] - rest[c.region]).max() > 0.05
+
+
+def test_fine_ids_follow_positions_when_a_collapse_moved_the_survivor():
+    """A half-edge collapse may leave vertex a at vertex b's position; the position names the
+    fine vertex, and coincident fine vertices are handed out once each."""
+    from srarap_cli.multires.simplify import _fine_ids
+    V = np.array([[0., 0, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0], [5, 5, 5]])
+    U = np.array([[0., 0, 0], [1, 0, 0], [1, 0, 0], [5, 5, 5]])
+    carried = np.array([0.0, 3.0, 1.0, 4.0])  # the second survivor carries 3 but sits on 1/2
+    ids = _fine_ids(V, U, carried)
+    assert np.array_equal(V[ids], U) and len(set(ids.tolist())) == 4
+    assert ids[0] == 0 and ids[3] == 4 and ids[2] == 1 and ids[1] == 2
