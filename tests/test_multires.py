@@ -223,3 +223,15 @@ def test_fine_ids_follow_positions_when_a_collapse_moved_the_survivor():
     ids = _fine_ids(V, U, carried)
     assert np.array_equal(V[ids], U) and len(set(ids.tolist())) == 4
     assert ids[0] == 0 and ids[3] == 4 and ids[2] == 1 and ids[1] == 2
+
+
+@pytest.mark.parametrize("method", ["sr-linear", "sr-linear-sym", "sr-relax", "arap"])
+def test_every_method_runs_through_multires_and_keeps_a_translation_exact(method):
+    import igl
+
+    from srarap_cli.multires.simplify import _octahedron
+    V, F = igl.loop(*igl.loop(*_octahedron()))
+    d = MultiresDeformer(V, F, np.arange(6), size=30, method=method)
+    r = d.solve(V[:6] + [0.5, -1.0, 2.0], max_iter=20)
+    assert np.abs(r.positions - (V + [0.5, -1.0, 2.0])).max() < 1e-9
+    assert d.coarse_deformer.method == method

@@ -78,7 +78,7 @@ def _face_corners(faces, path):
         if v.size and v.min() >= 1:
             return np.column_stack([v - 1, np.full(v.size, -1), np.full(v.size, -1)])
     except ValueError:
-        pass
+        pass  # "v/vt/vn" corners or bad tokens: the per-corner parser handles and reports them
     corners = [_corner(t, counts, path, lineno)
                for lineno, rest, counts in faces for t in rest.split()]
     return np.array(corners, dtype=np.int64).reshape(-1, 3)
