@@ -233,7 +233,7 @@ def unanchored(graph, constrained):
     n_parts, label = csgraph.connected_components(graph.laplacian, directed=False)
     anchored = np.zeros(n_parts, dtype=bool)
     anchored[label[constrained]] = True
-    lonely = np.flatnonzero(graph.degree == 0)
+    lonely = np.flatnonzero((graph.degree == 0) & ~constrained)
     floating = np.flatnonzero(~anchored[label] & (graph.degree > 0))
     notes = []
     if lonely.size:

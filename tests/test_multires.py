@@ -235,3 +235,17 @@ def test_every_method_runs_through_multires_and_keeps_a_translation_exact(method
     r = d.solve(V[:6] + [0.5, -1.0, 2.0], max_iter=20)
     assert np.abs(r.positions - (V + [0.5, -1.0, 2.0])).max() < 1e-9
     assert d.coarse_deformer.method == method
+
+
+def test_parts_without_handles_stay_at_rest_with_the_same_warning_as_a_direct_solve():
+    import igl
+
+    from srarap_cli.multires.simplify import _octahedron
+    V, F = igl.loop(*igl.loop(*igl.loop(*_octahedron())))
+    n = len(V)
+    V2, F2 = np.vstack([V, V + [5, 0, 0]]), np.vstack([F, F + n])
+    d = MultiresDeformer(V2, F2, np.array([0, 1]), np.array([0, 1]), size=100)
+    assert np.isin(np.arange(n, 2 * n), d.coarse.vertices).any()  # coarse vertices there too
+    r = d.solve(V2[[0, 1]] + [[0, 0, 0], [0, 0, 0.5]], max_iter=30)
+    assert np.array_equal(r.positions[n:], V2[n:])
+    assert any("without a constrained vertex (258 vertices)" in w for w in d.warnings)

@@ -92,10 +92,10 @@ class MultiresDeformer:
     def _build_fine(self):
         """Dirichlet set (coarse, constrained and immovable vertices) and its factorization."""
         known = np.zeros(len(self.V), dtype=bool)
-        known[self.coarse.vertices] = True
         known[self.constrained] = True
-        self.auto_fixed, notes = unanchored(self.graph, known)
+        self.auto_fixed, notes = unanchored(self.graph, known)  # as the direct solve would
         known[self.auto_fixed] = True
+        known[self.coarse.vertices] = True
         self._known = np.flatnonzero(known)
         self._row = np.full(len(self.V), -1)
         self._row[self._known] = np.arange(self._known.size)
