@@ -30,6 +30,13 @@ def unique_rows(a):
     return s[start], np.diff(np.append(start, len(s)))
 
 
+def edge_counts(F):
+    """Undirected edges (e, 2) of triangles F (sorted pairs) and how many triangles hold each."""
+    F = np.asarray(F)
+    return unique_rows(np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]),
+                               axis=1))
+
+
 def mesh_warnings(V, F):
     """Warning lines for duplicate faces, collapsed, zero-area and needle triangles, and
     non-manifold edges and vertices of a triangle mesh (V (n, 3), F (f, 3)).
@@ -66,8 +73,7 @@ def mesh_warnings(V, F):
 
 def _manifold_warnings(F, n):
     out = []
-    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    counts = unique_rows(edges)[1]
+    counts = edge_counts(F)[1]
     if (counts > 2).any():
         out.append(f"{int((counts > 2).sum())} non-manifold edges (more than two faces); solved, "
                    "the operators are defined there")

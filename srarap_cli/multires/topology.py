@@ -3,7 +3,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse import csgraph
 
-from ..mesh_checks import unique_rows
+from ..mesh_checks import edge_counts
 
 
 def topology_summary(F, n):
@@ -26,8 +26,7 @@ def topology_summary(F, n):
     1
     """
     F = np.asarray(F, dtype=np.int64)
-    half = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    edges, count = unique_rows(half)
+    edges, count = edge_counts(F)
     used = np.unique(F)
     adj = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
     components = csgraph.connected_components(adj, directed=False)[1][used]
