@@ -110,6 +110,7 @@ class Deformer:
             raise ValueError("feedback must be >= 0")
         self.V = np.asarray(V, dtype=float)
         self.F = np.asarray(F, dtype=np.int64)
+        self.weights = weights
         self.graph = cell_graph(self.V, self.F, weights)
         self.alpha = float(alpha)
         self.area = self.graph.area if area is None else float(area)

@@ -21,9 +21,9 @@ from ..solve_log import LOG_FORMATS
 from .common import (
     check_output_path,
     guarded,
+    multires_line,
     multires_options,
     solver_options,
-    stage_text,
 )
 
 STATE_NAME = ".srarap-animate-state.npz"
@@ -89,8 +89,7 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, m
     if not quiet:
         d = animator.deformer
         if isinstance(d, MultiresDeformer):
-            click.echo(f"srarap: multires: {len(d.coarse.vertices)} of {len(d.V)} vertices; "
-                       f"{stage_text(d.stages)}", err=True)
+            click.echo(multires_line(d.info, d.stages), err=True)
         stalled = sum(not r["converged"] for r in rows)
         seconds = sum(r["seconds"] for r in rows)
         click.echo(f"srarap animate: {len(rows)} frames ({stalled} stopped at "

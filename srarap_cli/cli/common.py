@@ -21,9 +21,11 @@ STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
                "fine_solve": "fine solve"}
 
 
-def stage_text(stages):
-    """``simplify 1.20 s, coarse setup 0.10 s, ...`` for a dict of stage seconds."""
-    return ", ".join(f"{STAGE_NAMES.get(k, k)} {v:.2f} s" for k, v in stages.items())
+def multires_line(info, stages):
+    """``srarap: multires: 5002 of 737986 vertices; simplify 1.20 s, ...`` for stderr."""
+    cached = " (coarse mesh from cache)" if info["cache_hit"] else ""
+    times = ", ".join(f"{STAGE_NAMES.get(k, k)} {v:.2f} s" for k, v in stages.items())
+    return f"srarap: multires: {info['vertices']} of {info['of']} vertices{cached}; {times}"
 
 
 def fail(code, message):

@@ -15,9 +15,9 @@ from ..solve_log import LOG_FORMATS, format_log
 from .common import (
     check_output_path,
     guarded,
+    multires_line,
     multires_options,
     solver_options,
-    stage_text,
 )
 from .render import preview_png
 
@@ -75,7 +75,7 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, met
         for note in notes + lost:
             click.echo(f"srarap: warning: {note}", err=True)
         if result.stages:
-            click.echo(f"srarap: multires: {stage_summary(result)}", err=True)
+            click.echo(multires_line(result.coarse, result.stages), err=True)
         click.echo(_summary(result, settings(constraints.solver, overrides), out), err=True)
     if not result.converged:
         raise SystemExit(exit_codes.NOT_CONVERGED)
@@ -93,9 +93,3 @@ def _summary(result, opts, out):
             f"{sum(result.stages.values()) if result.stages else last['seconds']:.2f} s; "
             f"wrote {out}")
 
-
-def stage_summary(result):
-    """One line: coarse size and seconds per multiresolution stage."""
-    cached = " (coarse mesh from cache)" if result.coarse["cache_hit"] else ""
-    times = stage_text(result.stages)
-    return f"{result.coarse['vertices']} of {result.coarse['of']} vertices{cached}; {times}"

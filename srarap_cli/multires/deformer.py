@@ -12,7 +12,7 @@ from ..deformer import (
     weight_warnings,
 )
 from ..energy import bending_energy, membrane_energy
-from ..operators import cell_graph
+from ..operators import cell_graph, mesh_area
 from ..quaternion import IDENTITY
 from ..rest_edges import RestEdges
 from .cache import coarse_mesh
@@ -66,17 +66,21 @@ class MultiresDeformer:
         groups = [self.constrained[self.labels == g] for g in range(self.n_groups)]
         self.coarse, self.cache_hit, notes = coarse_mesh(self.V, self.F, size, groups, cache)
         self.stages = {"simplify": time.perf_counter() - start}
-        mark = time.perf_counter()
-        self.graph = cell_graph(self.V, self.F, options.get("weights", "cotan-clamped"))
-        self.area = self.graph.area if area is None else float(area)
-        self.alpha = float(options.get("alpha", 0.14))
+        self.area = mesh_area(self.V, self.F) if area is None else float(area)
         self._build_coarse(options)
+        mark = time.perf_counter()
         fixed_notes = self._build_fine()
-        self.stages["factor"] = (time.perf_counter() - mark
-                                 - self.stages["coarse_precompute"])
+        self.stages["factor"] = time.perf_counter() - mark
+        self.alpha = self.coarse_deformer.alpha
         self._bending_alpha = self.alpha if self.coarse_deformer.local_step.bending else 0.0
         self.warnings = (weight_warnings(self.graph) + fixed_notes + notes
                          + [f"multires: {w}" for w in self.coarse.warnings])
+
+    @property
+    def info(self):
+        """``vertices`` (coarse count), ``of`` (full count), ``cache_hit``."""
+        return {"vertices": int(self.coarse.vertices.size), "of": len(self.V),
+                "cache_hit": self.cache_hit}
 
     def _build_coarse(self, options):
         start = time.perf_counter()
@@ -91,6 +95,7 @@ class MultiresDeformer:
 
     def _build_fine(self):
         """Dirichlet set (coarse, constrained and immovable vertices) and its factorization."""
+        self.graph = cell_graph(self.V, self.F, self.coarse_deformer.weights)
         known = np.zeros(len(self.V), dtype=bool)
         known[self.constrained] = True
         self.auto_fixed, notes = unanchored(self.graph, known)  # as the direct solve would
@@ -130,8 +135,7 @@ class MultiresDeformer:
         return DeformResult(P, R, coarse.log, coarse.converged, coarse.iterations,
                             full_energy={"membrane": membrane, "bending": bending,
                                          "total": membrane + bending}, stages=stages,
-                            coarse={"vertices": int(cv.size), "of": len(self.V),
-                                    "cache_hit": self.cache_hit})
+                            coarse=self.info)
 
     def _known_rotors(self, targets, coarse_rotors):
         out = np.tile(IDENTITY, (self._known.size, 1))
