@@ -249,3 +249,18 @@ def test_parts_without_handles_stay_at_rest_with_the_same_warning_as_a_direct_so
     r = d.solve(V2[[0, 1]] + [[0, 0, 0], [0, 0, 0.5]], max_iter=30)
     assert np.array_equal(r.positions[n:], V2[n:])
     assert any("without a constrained vertex (258 vertices)" in w for w in d.warnings)
+
+
+def test_one_fine_factorization_serves_transfer_and_final_solve_for_every_pose(monkeypatch):
+    import igl
+
+    from srarap_cli.multires import deformer as module
+    from srarap_cli.multires.simplify import _octahedron
+    built = []
+    real = module.DirichletSolver
+    monkeypatch.setattr(module, "DirichletSolver", lambda *a: built.append(1) or real(*a))
+    V, F = igl.loop(*igl.loop(*_octahedron()))
+    d = MultiresDeformer(V, F, np.arange(6), size=30)
+    for shift in (0.5, 1.0, 1.5):
+        d.solve(V[:6] + shift, max_iter=5)
+    assert len(built) == 1
