@@ -1,9 +1,9 @@
 """Per-vertex distortion of a deformed mesh against its rest shape."""
 import numpy as np
 
-from .local_step.arap import closest_rotations
+from .closest_rotors import closest_rotors
 from .operators import cell_graph
-from .quaternion import from_matrix, rotate
+from .quaternion import IDENTITY, rotate
 from .rest_edges import RestEdges
 
 
@@ -30,7 +30,7 @@ def vertex_distortion(rest, deformed, F):
     g = cell_graph(rest, F)
     edges = RestEdges(g, rest)
     S, _ = edges.covariance(deformed)
-    R = from_matrix(closest_rotations(S))
+    R = closest_rotors(S, np.tile(IDENTITY, (len(S), 1)))
     residual = rotate(R[g.I], edges.q) - edges.deformed(deformed)
     e = g.cell_sum(g.c * np.einsum("ij,ij->i", residual, residual))
     scale = edges.rest_scale

@@ -35,6 +35,22 @@ def multiply(a, b):
     ], axis=-1)
 
 
+def _product_basis():
+    """``T[a, b] = Lmul(e_a) Rmul(e_b)`` for the pure unit quaternions ``e_a, e_b``: (3, 3, 4, 4)."""
+    eye = np.eye(4)
+    T = np.empty((3, 3, 4, 4))
+    for a in range(3):
+        for b in range(3):
+            # column k of Lmul(e_a) Rmul(e_b) is e_a * (e_k * e_b)
+            T[a, b] = multiply(eye[1 + a], multiply(eye, eye[1 + b])).T
+    return T
+
+
+# sum_ab S_ab PRODUCT_BASIS[a, b] is the 4x4 matrix of r -> sum_ab S_ab e_a r e_b: the membrane
+# (local_step.membrane) and Horn (closest_rotors) matrices are built from it
+PRODUCT_BASIS = _product_basis()
+
+
 def rotate(q, v):
     """Rotate vectors ``v`` by unit quaternions ``q`` (``q v q~``).
 

@@ -9,21 +9,7 @@ linear in the 3x3 tensor ``p q^T``. So a cell needs only ``S_i = sum_j c_ij p_ij
 """
 import numpy as np
 
-from ..quaternion import multiply
-
-
-def _product_basis():
-    """``T[a, b] = Lmul(e_a) Rmul(e_b)`` for the pure unit quaternions ``e_a, e_b``."""
-    eye = np.eye(4)
-    T = np.empty((3, 3, 4, 4))
-    for a in range(3):
-        for b in range(3):
-            # column k of Lmul(e_a) Rmul(e_b) is e_a * (e_k * e_b)
-            T[a, b] = multiply(eye[1 + a], multiply(eye, eye[1 + b])).T
-    return T
-
-
-_BASIS = _product_basis()
+from ..quaternion import PRODUCT_BASIS
 
 
 def membrane_matrices(S, s):
@@ -36,4 +22,4 @@ def membrane_matrices(S, s):
     >>> float(np.array([1., 0, 0, 0]) @ M[0] @ np.array([1., 0, 0, 0]))  # identity fits
     0.0
     """
-    return s[:, None, None] * np.eye(4) + 2.0 * np.einsum("nab,abij->nij", S, _BASIS)
+    return s[:, None, None] * np.eye(4) + 2.0 * np.einsum("nab,abij->nij", S, PRODUCT_BASIS)
