@@ -158,9 +158,10 @@ class Deformer:
         start = time.perf_counter()
         targets = np.asarray(targets, dtype=float).reshape(-1, 3)
         fixed_targets = self._fixed_targets(targets)
+        poisson = self.poisson.bind(fixed_targets)
         if initial is None:
             R = np.tile(IDENTITY, (len(self.V), 1))
-            P = self.poisson.solve(self.edges.rotated_divergence(R), fixed_targets)
+            P = poisson(self.edges.rotated_divergence(R))
         else:
             P = np.array(initial[0], dtype=float)
             R = np.array(initial[1], dtype=float)
@@ -171,7 +172,7 @@ class Deformer:
         for k in range(1, max_iter + 1):
             R = self.local_step.step(state["S"], state["s"], R)
             Rm = to_matrix(R)
-            P_new = self.poisson.solve(self.edges.rotated_divergence(R, Rm), fixed_targets)
+            P_new = poisson(self.edges.rotated_divergence(R, Rm))
             state = self._state(P_new, R, Rm)
             row = self._record(result, state, P, tol, start, callback)
             P = P_new
@@ -185,20 +186,25 @@ class Deformer:
         return result
 
     def _state(self, P, R, Rm=None):
-        """What an iteration knows about positions ``P`` with rotors ``R``: edges, covariances
-        (also the next local step's input) and rotation matrices."""
-        p = self.edges.deformed(P)
-        S, s = self.edges.covariance(P, p)
-        return {"P": P, "R": R, "p": p, "S": S, "s": s,
+        """What an iteration knows about positions ``P`` with rotors ``R``: covariances (the
+        next local step's input; per-cell stretch only for the steps that use it), the total
+        stretch (for the energy) and rotation matrices."""
+        S = self.edges.cross(P)
+        if self.local_step.needs_stretch:
+            s = self.edges.stretch(P)
+            total = float(s.sum())
+        else:
+            s, total = None, self.edges.stretch_total(P)
+        return {"P": P, "R": R, "S": S, "s": s, "stretch_total": total,
                 "Rm": to_matrix(R) if Rm is None else Rm}
 
     def _membrane(self, st, tol):
         """Membrane energy from the covariances when that is accurate enough for ``tol``,
         else from the per-edge residuals (near-rigid shapes, ``tol`` 0)."""
-        fast = membrane_from_covariance(st["S"], st["s"], st["Rm"])
-        if accurate_enough(fast, float(st["s"].sum()), tol):
+        fast = membrane_from_covariance(st["S"], st["stretch_total"], st["Rm"])
+        if accurate_enough(fast, st["stretch_total"], tol):
             return fast
-        return membrane_energy(self.graph, self.edges.q, st["P"], st["R"], st["p"])
+        return membrane_energy(self.graph, self.edges.q, st["P"], st["R"])
 
     def _record(self, result, st, P_prev, tol, start, callback):
         P = st["P"]
@@ -211,8 +217,9 @@ class Deformer:
             rel, move = float("nan"), 0.0
         else:
             previous = result.log[-1]["total"]
-            rel = abs(total - previous) / max(previous, self._energy_floor)
-            move = float(np.sqrt(np.max(np.sum((P - P_prev) ** 2, axis=1), initial=0.0)))
+            rel = abs(total - previous) / max(abs(previous), self._energy_floor)
+            d = P - P_prev
+            move = float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d), initial=0.0)))
         row = {"iteration": len(result.log), "membrane": membrane, "bending": bending,
                "total": total, "rel_change": rel, "max_move": move,
                "seconds": time.perf_counter() - start}

@@ -35,24 +35,27 @@ def membrane_energy(graph, rest_edges, P, R, deformed_edges=None):
     return float(graph.c @ np.einsum("ij,ij->i", residual, residual))
 
 
-def membrane_from_covariance(S, s, Rm):
+def membrane_from_covariance(S, stretch_total, Rm):
     """The membrane energy from cell covariances: ``sum_i s_i - 2 trace(R_i^T S_i)``.
 
-    Exact algebra (``|Rq - p|^2 = |q|^2 + |p|^2 - 2 p.Rq``), nearly free once ``S, s`` are
-    known, but it cancels: its rounding error is about ``1e-16 * sum(s)``, so it is only
-    trustworthy when the energy is far above that (see :func:`accurate_enough`).
+    Exact algebra (``|Rq - p|^2 = |q|^2 + |p|^2 - 2 p.Rq``), nearly free once ``S`` and
+    ``sum_i s_i`` are known, but it cancels: its rounding error is about
+    ``1e-16 * sum_i s_i``, so it is only trustworthy when the energy is far above that (see
+    :func:`accurate_enough`).
 
     Parameters
     ----------
-    S : (n, 3, 3), s : (n,) from RestEdges.covariance; Rm : (n, 3, 3) rotation matrices
+    S : (n, 3, 3) from RestEdges.cross; stretch_total : float, RestEdges.stretch_total;
+    Rm : (n, 3, 3) rotation matrices
     """
-    return float(s.sum() - 2.0 * np.einsum("nab,nab->", Rm, S))
+    return float(stretch_total - 2.0 * np.einsum("nab,nab->", Rm, S))
 
 
 def accurate_enough(value, scale, tol):
     """Whether a cancelling evaluation of size ``value`` (rounding ~1e-16 * ``scale``) is
-    accurate to 1% of the relative tolerance ``tol`` the caller will test it against."""
-    return tol > 0 and value * tol >= 1e-14 * scale
+    accurate to 1% of the relative tolerance ``tol`` the caller will test it against.
+    (``value`` is negative only when negative cotangent weights make the energy unbounded.)"""
+    return tol > 0 and abs(value) * tol >= 1e-14 * scale
 
 
 def bending_energy(graph, R, alpha, area):

@@ -3,7 +3,8 @@
 Every method is a class built once per mesh and constraint set,
 ``Step(rest_edges, constrained_mask, alpha * A, feedback, **options)``, whose ``step(S, s, R_prev)``
 returns new unit rotors from the cells' covariances (see ``membrane``). ``bending`` says
-whether the method's energy has the bending term.
+whether the method's energy has the bending term, ``needs_stretch`` whether ``step`` uses the
+per-cell ``s`` (otherwise it gets None).
 """
 from .arap import ArapRotorStep
 from .linear import LinearRotorStep

@@ -16,6 +16,7 @@ class LinearRotorStep(RotorSystem):
     """The paper's rotor system. Parameters: rest edges, constrained mask, ``alpha*A``, ``eps``."""
 
     bending = True
+    needs_stretch = True
 
     def __init__(self, edges, constrained, alpha_area, feedback):
         graph = edges.graph

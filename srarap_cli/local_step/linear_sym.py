@@ -22,6 +22,7 @@ class SymmetricRotorStep(RotorSystem):
     """Total-energy rotor system. Parameters: rest edges, constrained mask, ``alpha*A``, ``eps``."""
 
     bending = True
+    needs_stretch = True
 
     def __init__(self, edges, constrained, alpha_area, feedback):
         graph = edges.graph
