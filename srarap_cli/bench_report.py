@@ -57,11 +57,13 @@ def plot_png(runs, title):
 
     sr = [r for r in runs if r.name in SR_METHODS]
     classic = [r for r in runs if r.name not in SR_METHODS]
-    fig, axes = plt.subplots(1, 2 if classic else 1, figsize=(11 if classic else 6, 4.2),
+    both = bool(sr) and bool(classic)
+    fig, axes = plt.subplots(1, 2 if both else 1, figsize=(11 if both else 6, 4.2),
                              squeeze=False)
-    panels = [(axes[0, 0], sr, "SR-ARAP energy above the best reached")]
-    if classic:
-        panels.append((axes[0, 1], classic, "classic ARAP energy above the best reached"))
+    panels = [(ax, group, label) for ax, group, label in zip(
+        axes[0], [g for g in (sr, classic) if g],
+        [t for g, t in ((sr, "SR-ARAP energy above the best reached"),
+                        (classic, "classic ARAP energy above the best reached")) if g])]
     for ax, group, label in panels:
         best = min((row["total"] for r in group for row in r.log), default=0.0)
         for r in group:

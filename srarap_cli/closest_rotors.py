@@ -22,7 +22,7 @@ _HORN = -PRODUCT_BASIS.reshape(9, 16).T  # K_ij = sum_ab S_ab _HORN[4i + j, 3a +
 _LAGUERRE_STEPS = 12
 # cells per block: the two dozen temporaries of a block stay in cache (100k cells: 45 -> 32 ms)
 _BLOCK = 8192
-_STEP_TOL = 1e-14
+_ROOT_TOL = 1e-14
 # below this share v_j^2 of the eigenvector, adjugate column j has lost too many digits
 _MIN_WEIGHT = 0.05
 # eigenvalue gap measure P'(x) below this (relative to |S|^3): rotation nearly undetermined
@@ -69,7 +69,8 @@ def _closest_block(S, ref):
     det = (s[0] * (s[4] * s[8] - s[5] * s[7]) - s[1] * (s[3] * s[8] - s[5] * s[6])
            + s[2] * (s[3] * s[7] - s[4] * s[6]))
     k = _HORN @ s
-    rayleigh = np.einsum("in,in->n", k, (ref[:, :, None] * ref[:, None, :]).reshape(n, 16).T)
+    r = np.ascontiguousarray(ref.T)
+    rayleigh = np.einsum("in,in->n", k, (r[:, None] * r[None, :]).reshape(16, n))
     top, slope, converged = _top_eigenvalue(norm2, _gram_norm2(s), det, rayleigh)
     usable = converged & (slope > _MIN_GAP * norm2 * np.sqrt(norm2))
     v = _adjugate_column0(k[4:], top)
@@ -95,10 +96,9 @@ def _top_eigenvalue(norm2, gram2, det, lower):
     increasing and convex from it on (all of ``P``'s roots are real, so then only the largest
     lies above it), one Newton step lands on or above the root; elsewhere the start is the
     upper bound ``sqrt(3 |S|^2)``. From above, Laguerre's iteration descends to the root
-    monotonically and converges cubically: two or three steps near the previous rotors, five
-    from the upper bound (where Newton took seven to thirteen on the benchmark meshes). A cell
-    has converged once its step is at the rounding level or negative (rounding pushed it
-    past the root). ``P'`` at the root is the product of the gaps to the other eigenvalues.
+    monotonically and converges cubically: one or two steps near the previous rotors, four
+    or five from the upper bound (where Newton took seven to thirteen on the benchmark
+    meshes). ``P'`` at the root is the product of the gaps to the other eigenvalues.
     """
     a2, a1, a0 = -2.0 * norm2, -8.0 * det, 2.0 * gram2 - norm2 * norm2
     upper = np.sqrt(3.0 * norm2)
@@ -108,24 +108,26 @@ def _top_eigenvalue(norm2, gram2, det, lower):
     convex = (lower > 0) & (dp > 0) & (12.0 * x2 + 2.0 * a2 > 0)
     newton = lower - np.divide(p, dp, out=np.zeros_like(p), where=convex)
     x = np.where(convex & (newton < upper), newton, upper)
-    floor = _STEP_TOL * upper
+    floor = _ROOT_TOL * upper
     converged = np.zeros(x.shape, dtype=bool)
     for _ in range(_LAGUERRE_STEPS):
         x2 = x * x
         p = (x2 + a2) * x2 + a1 * x + a0
         dp = (4.0 * x2 + 2.0 * a2) * x + a1
+        # above the largest of four real roots, x - root <= 4 P / P': stop once that is at the
+        # rounding level (or P < 0: rounding put x past the root)
+        converged |= 4.0 * p <= floor * dp
+        if converged.all():
+            break
         ddp = 12.0 * x2 + 2.0 * a2
         root = np.sqrt(np.maximum(3.0 * (3.0 * dp * dp - 4.0 * p * ddp), 0.0))
         denominator = dp + root
         # converged cells stay put, so a cell's result does not depend on the other cells
-        step = np.divide(4.0 * p, denominator, out=np.zeros_like(p),
-                         where=(denominator > 0) & ~converged)
-        x -= step
-        converged |= step <= floor
-        if converged.all():
-            break
-    slope = (4.0 * x * x + 2.0 * a2) * x + a1
-    return x, slope, converged
+        x -= np.divide(4.0 * p, denominator, out=np.zeros_like(p),
+                       where=(denominator > 0) & ~converged)
+    else:
+        dp = (4.0 * x * x + 2.0 * a2) * x + a1
+    return x, dp, converged
 
 
 def _adjugate_column0(rows, x):
@@ -150,22 +152,24 @@ def _normalized(v, slope, usable):
     return v / np.sqrt(np.where(good, weight, 1.0)), good
 
 
+def _swap_tables():
+    """Per column j: the flattened-K index of ``K[p[a], p[b]]`` (16,) and the permutation
+    ``p`` (4,) swapping 0 and j (column j of adj(K) is column 0 of adj(K swapped))."""
+    swaps = np.array([[j if a == 0 else 0 if a == j else a for a in range(4)] for j in range(4)])
+    return (4 * swaps[:, :, None] + swaps[:, None, :]).reshape(4, 16), swaps
+
+
+_SWAP16, _SWAP4 = _swap_tables()
+
+
 def _hard_cells(k, x, slope, usable, reference):
     """Rotors (4, h) of cells column 0 did not serve: the column of the reference's largest
     component (rotations near a half turn), else ``eigh``."""
-    q = np.empty((4, len(x)))
     pick = np.argmax(np.abs(reference), axis=1)
-    todo = np.ones(len(x), dtype=bool)
-    for j in range(1, 4):
-        cells = np.flatnonzero((pick == j) & usable)
-        swap = np.arange(4)
-        swap[[0, j]] = j, 0  # column j of adj(K) is column 0 of adj(K with 0 and j swapped)
-        permuted = k[(4 * swap[:, None] + swap).ravel()][:, cells]
-        v, good = _normalized(_adjugate_column0(permuted[4:], x[cells]), slope[cells],
-                              usable[cells])
-        q[:, cells] = v[swap]
-        todo[cells[good]] = False
-    rest = np.flatnonzero(todo)
+    swapped = np.take_along_axis(k, _SWAP16[pick].T, axis=0)
+    v = np.take_along_axis(_adjugate_column0(swapped[4:], x), _SWAP4[pick].T, axis=0)
+    q, good = _normalized(v, slope, usable & (pick > 0))
+    rest = np.flatnonzero(~good)
     if rest.size:
         q[:, rest] = _by_eigh(k[:, rest], reference[rest]).T
     return q
