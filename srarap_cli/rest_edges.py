@@ -62,8 +62,10 @@ class RestEdges:
         return self.cross(P), self.stretch(P, p)
 
     def cross(self, P):
-        """``S_i = sum_j c_ij p_ij q_ij^T``: (n, 3, 3), a view of one sparse product."""
-        return (self._covariance @ P).reshape(3, self.graph.n, 3).transpose(1, 2, 0)
+        """``S_i = sum_j c_ij p_ij q_ij^T``: (n, 3, 3), from one sparse product."""
+        # contiguous: einsums over a transposed view ran twice as slow downstream
+        return np.ascontiguousarray(
+            (self._covariance @ P).reshape(3, self.graph.n, 3).transpose(1, 2, 0))
 
     def stretch(self, P, p=None):
         """``s_i = sum_j c_ij(|p_ij|^2 + |q_ij|^2)``: (n,)."""
