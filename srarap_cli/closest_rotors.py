@@ -63,6 +63,7 @@ def closest_rotors(S, reference):
 
 
 def _closest_block(S, ref):
+    """:func:`closest_rotors` for one block of cells."""
     n = len(S)
     s = np.moveaxis(S, 0, -1).reshape(9, n)  # s[3a + b] = S[:, a, b]
     norm2 = np.einsum("ij,ij->j", s, s)

@@ -40,8 +40,6 @@ class PoissonSolver:
     """
 
     def __init__(self, graph, constrained):
-        self.graph = graph
-        self.free = np.flatnonzero(~constrained)
         self.fixed = np.flatnonzero(constrained)
         K = graph.laplacian
         keep = sp.diags((~constrained).astype(float))
@@ -50,18 +48,17 @@ class PoissonSolver:
         self._free_column = (~constrained).astype(float)[:, None]
 
     def bind(self, targets):
-        """The solve for one set of constrained positions ``targets`` (k, 3), in index order:
-        a function from ``b`` (n, 3) to positions (n, 3), for many ``b``."""
-        base = -(self._to_fixed @ targets) * self._free_column
-        base[self.fixed] = targets
-        return lambda b: self._solve(base - b * self._free_column)
-
-    def solve(self, b, targets):
-        """Positions with ``P[fixed] = targets`` minimizing the membrane energy for ``b``.
+        """The solve for one set of constrained positions, reused for many right-hand sides.
 
         Parameters
         ----------
-        b : (n, 3) float array, from :meth:`RestEdges.rotated_divergence`
         targets : (k, 3) float array, positions of the constrained vertices in index order
+
+        Returns
+        -------
+        callable: ``b`` (n, 3) (from :meth:`RestEdges.rotated_divergence`) -> positions (n, 3)
+        with ``P[fixed] = targets`` minimizing the membrane energy for ``b``
         """
-        return self.bind(targets)(b)
+        base = -(self._to_fixed @ targets) * self._free_column
+        base[self.fixed] = targets
+        return lambda b: self._solve(base - b * self._free_column)
