@@ -82,8 +82,7 @@ def _run_igl(V, F, ids, targets, time_budget, max_iter):
 
 def _igl_row(scorer, P, k, seconds, P_prev):
     """Our classic-ARAP energy of libigl's positions (best-fit rotations per cell)."""
-    S, s = scorer.edges.covariance(P)
-    R = scorer.local_step.step(S, s, np.tile([1.0, 0, 0, 0], (len(P), 1)))
+    R = scorer.local_step.step(scorer.edges.cross(P), None, np.tile([1.0, 0, 0, 0], (len(P), 1)))
     e = membrane_energy(scorer.graph, scorer.edges.q, P, R)
     move = 0.0 if P_prev is None else float(np.linalg.norm(P - P_prev, axis=1).max())
     return {"iteration": k, "membrane": e, "bending": 0.0, "total": e, "rel_change": float("nan"),

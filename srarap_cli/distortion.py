@@ -29,8 +29,7 @@ def vertex_distortion(rest, deformed, F):
     """
     g = cell_graph(rest, F)
     edges = RestEdges(g, rest)
-    S, _ = edges.covariance(deformed)
-    R = closest_rotors(S, np.tile(IDENTITY, (len(S), 1)))
+    R = closest_rotors(edges.cross(deformed), np.tile(IDENTITY, (len(rest), 1)))
     residual = rotate(R[g.I], edges.q) - edges.deformed(deformed)
     e = g.cell_sum(g.c * np.einsum("ij,ij->i", residual, residual))
     scale = edges.rest_scale

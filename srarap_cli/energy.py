@@ -12,7 +12,7 @@ import numpy as np
 from .quaternion import rotate
 
 
-def membrane_energy(graph, rest_edges, P, R, deformed_edges=None):
+def membrane_energy(graph, rest_edges, P, R):
     """``sum_i sum_j c_ij |R_i q_ij R_i~ - p_ij|^2``, from per-edge residuals.
 
     Parameters
@@ -21,16 +21,12 @@ def membrane_energy(graph, rest_edges, P, R, deformed_edges=None):
     rest_edges : (m, 3) float array
     P : (n, 3) float array, deformed positions
     R : (n, 4) float array, unit rotors
-    deformed_edges : (m, 3) float array, optional ``p_ij`` when already computed
 
     Summing residuals (rather than expanding ``|q|^2 + |p|^2 - 2 p.Rq``) keeps the value
     accurate down to the rounding of the positions, so convergence near a rigid motion is
     still measurable.
     """
-    if deformed_edges is None:
-        p = np.take(P, graph.J, axis=0) - np.take(P, graph.I, axis=0)
-    else:
-        p = deformed_edges
+    p = np.take(P, graph.J, axis=0) - np.take(P, graph.I, axis=0)
     residual = rotate(np.take(R, graph.I, axis=0), rest_edges) - p
     return float(graph.c @ np.einsum("ij,ij->i", residual, residual))
 
