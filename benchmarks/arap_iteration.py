@@ -21,7 +21,7 @@ import time
 import igl
 import numpy as np
 
-from srarap_cli.deformer import Deformer
+from srarap_cli import Deformer
 from srarap_cli.handles import load_handles
 from srarap_cli.mesh_io import read_mesh
 from srarap_cli.pipeline import problem

@@ -16,10 +16,10 @@ import time
 import igl
 import numpy as np
 
-from srarap_cli.deformer import Deformer
+from srarap_cli import Deformer
 from srarap_cli.handles import load_handles
 from srarap_cli.mesh_io import read_mesh
-from srarap_cli.pipeline import settings
+from srarap_cli.settings import resolve
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -33,7 +33,7 @@ CASES = [
 
 
 def srarap_run(V, F, c, tol, method):
-    opts = settings(c.solver, {"tol": tol, "method": method})
+    opts = resolve(c.solver, {"tol": tol, "method": method})
     t0 = time.perf_counter()
     d = Deformer(V, F, c.ids, alpha=opts["alpha"], feedback=opts["feedback"],
                  weights=opts["weights"], method=opts["method"])

@@ -16,19 +16,16 @@ import time
 
 import numpy as np
 
-from srarap_cli.deformer import DeformResult
-from srarap_cli.energy import bending_energy, membrane_energy
+from srarap_cli import DeformResult
 from srarap_cli.handles import load_handles
 from srarap_cli.mesh_io import read_mesh
-from srarap_cli.pipeline import build_deformer, problem, settings
+from srarap_cli.pipeline import build_deformer, problem
+from srarap_cli.settings import resolve
 
 
 def refit_energy(direct, P, R):
     """Energy of positions P with rotors from one full-resolution local step."""
-    state = direct._state(P, R)
-    R_fit = direct.local_step.step(state["S"], state["s"], R)
-    return (membrane_energy(direct.graph, direct.edges.q, P, R_fit)
-            + bending_energy(direct.graph, R_fit, direct.alpha, direct.area))
+    return direct.energy(P, direct.best_rotors(P, R))["total"]
 
 
 def run(p, opts, size, tol, max_iter):
@@ -67,7 +64,7 @@ def main():
     mesh = read_mesh(args.mesh)
     c = load_handles(args.handles, mesh.vertices)
     p = problem(mesh, c)
-    opts = settings(c.solver, {})
+    opts = resolve(c.solver, {})
     direct, ref, direct_s = reference(p, opts, args)
     diag = float(np.linalg.norm(np.ptp(p.V, axis=0)))
     e_ref = ref.energy

@@ -15,7 +15,6 @@ import json
 import numpy as np
 import scipy.sparse as sp
 
-from srarap_cli.energy import bending_energy, membrane_energy
 from srarap_cli.handles import load_handles
 from srarap_cli.mesh_io import read_mesh
 from srarap_cli.multires import MultiresDeformer
@@ -38,17 +37,17 @@ def main():
     for size in args.sizes:
         d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=size)
         r = d.solve(p.targets, max_iter=5000, tol=1e-6)
-        g = d.graph
+        g = d.fine.graph
         W = sp.csr_matrix((np.ones(len(g.I)), (g.I, g.J)), shape=(g.n, g.n))
         W = sp.diags(1 / np.maximum(np.asarray(W.sum(1)).ravel(), 1)) @ W
-        known = d._known_positions(p.targets, r.positions[d.coarse.vertices])
+        known = d.known_positions(p.targets, r.positions[d.coarse.vertices])
         for k in (0, 2, 5, 10, 20):
             R = r.rotors
             for _ in range(k):
                 R = normalize(0.5 * R + 0.5 * (W @ R), np.broadcast_to(IDENTITY, R.shape))
-            P = d.solver.solve(known, d.edges.rotated_divergence(R))
-            m = membrane_energy(g, d.edges.q, P, R)
-            b = bending_energy(g, R, d.alpha, d.area)
+            P = d.solver.solve(known, d.fine.edges.rotated_divergence(R))
+            e = d.fine.energy(P, R)
+            m, b = e["membrane"], e["bending"]
             dist = np.linalg.norm(P - P_direct, axis=1) / diag
             print(f"coarse {size}, smoothing passes {k}: E/E_direct {(m + b) / e_direct:.3f} "
                   f"(membrane {m:.4f}, bending {b:.4f}), max dist {dist.max():.2e}, "

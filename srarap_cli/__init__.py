@@ -3,9 +3,10 @@
 Public API: :class:`Deformer` (precompute once, solve many times), :func:`deform` (one shot),
 :func:`read_mesh` / :func:`write_mesh`, :func:`load_handles`, :func:`deform_mesh`.
 """
-from .deformer import Deformer, DeformResult, deform
+from .deformer import Deformer, DeformResult
 from .handles import Constraints, load_handles
 from .mesh_io import Mesh, read_mesh, write_mesh
+from .oneshot import deform
 from .pipeline import deform_mesh
 
 __all__ = [

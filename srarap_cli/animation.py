@@ -4,6 +4,7 @@ The deformer is built once. Frame ``f`` starts from frame ``f-1``'s positions an
 the feedback term pulls every rotor toward its previous value (paper section 6.3), and
 rotors are kept on the hemisphere of their previous value.
 """
+import hashlib
 import io
 import json
 import time
@@ -61,12 +62,14 @@ class Animator:
         self.constraints = constraints
         self.problem = problem(mesh, constraints)
         self.deformer = build_deformer(self.problem, opts, cache)
+        self.last_result = None
 
     def run(self, frames, *, iters_per_frame, tol, state=None, on_frame=None, fingerprint=""):
         """Solve frames ``state.frame + 1`` (or 0) to ``frames - 1``.
 
         ``on_frame(frame, positions, state)`` receives the full-mesh positions (n, 3) and the
-        FrameState after each frame. Returns the final FrameState (or ``state`` if none ran).
+        FrameState after each frame. Returns the final FrameState (or ``state`` if none ran);
+        ``last_result`` keeps the last frame's solver result.
         """
         P = R = None
         rows = []
@@ -79,6 +82,7 @@ class Animator:
             targets = self.problem.targets_for(frame_targets)
             result = self.deformer.solve(targets, max_iter=iters_per_frame, tol=tol,
                                          initial=None if P is None else (P, R))
+            self.last_result = result
             # the solver's own rotors against the previous frame's: negative means a sign flip
             dot = 1.0 if R is None else float(np.einsum("ij,ij->i", result.rotors, R).min())
             R = result.rotors if R is None else align_hemisphere(result.rotors, R)
@@ -93,3 +97,14 @@ class Animator:
                 on_frame(f, scatter(self.mesh, self.problem, P, self.constraints, frame_targets),
                          state)
         return state
+
+
+def fingerprint(paths, opts, *extra):
+    """Content hash of the files ``paths``, the resolved settings and anything else that
+    decides the frames (``extra``, JSON-serializable): a resume state belongs to one run."""
+    h = hashlib.sha256()
+    for path in paths:
+        with open(path, "rb") as fh:
+            h.update(hashlib.sha256(fh.read()).digest())
+    h.update(json.dumps([opts, *extra], sort_keys=True).encode())
+    return h.hexdigest()

@@ -26,10 +26,11 @@ import yaml
 
 from .compare import compare_meshes
 from .errors import InputError
-from .handles import SOLVER_KEYS, load_handles
+from .handles import load_handles
 from .mesh_io import format_mesh, read_mesh
 from .mesh_io.commit import commit_files
 from .pipeline import deform_mesh
+from .settings import parse_mapping
 
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
 SUMMARY_FIELDS = ("job", "status", "iterations", "energy", "seconds", "compare_max", "message")
@@ -76,9 +77,7 @@ def load_manifest(path):
 
 
 def _settings(where, key, spec):
-    if not isinstance(spec, dict) or set(spec) - set(SOLVER_KEYS):
-        raise InputError(f"{where}: {key} must be a mapping of {', '.join(SOLVER_KEYS)}")
-    return dict(spec)
+    return parse_mapping(spec, key, lambda message: InputError(f"{where}: {message}"))
 
 
 def referenced_files(handles):

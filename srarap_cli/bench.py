@@ -12,7 +12,6 @@ import igl
 import numpy as np
 
 from .deformer import Deformer
-from .energy import membrane_energy
 
 SR_METHODS = ("sr-linear", "sr-linear-sym", "sr-relax")
 ALL_METHODS = SR_METHODS + ("arap",)
@@ -82,8 +81,8 @@ def _run_igl(V, F, ids, targets, time_budget, max_iter):
 
 def _igl_row(scorer, P, k, seconds, P_prev):
     """Our classic-ARAP energy of libigl's positions (best-fit rotations per cell)."""
-    R = scorer.local_step.step(scorer.edges.cross(P), None, np.tile([1.0, 0, 0, 0], (len(P), 1)))
-    e = membrane_energy(scorer.graph, scorer.edges.q, P, R)
+    R = scorer.best_rotors(P, np.tile([1.0, 0, 0, 0], (len(P), 1)))
+    e = scorer.energy(P, R)["membrane"]
     move = 0.0 if P_prev is None else float(np.linalg.norm(P - P_prev, axis=1).max())
     return {"iteration": k, "membrane": e, "bending": 0.0, "total": e, "rel_change": float("nan"),
             "max_move": move, "seconds": seconds}

@@ -1,11 +1,9 @@
 """Files and table of a benchmark: curves CSV, summary JSON, energy-vs-time PNG."""
-import csv
 import io
 import json
-import math
 
 from .bench import IGL, SR_METHODS
-from .deformer import LOG_FIELDS
+from .solve_log import LOG_FIELDS, format_log
 
 COLUMNS = [("method", "method", "{}"), ("iterations", "iters", "{}"),
            ("ms_per_iteration", "ms/iter", "{:.2f}"), ("iterations_to_1%", "it@1%", "{}"),
@@ -16,14 +14,8 @@ COLUMNS = [("method", "method", "{}"), ("iterations", "iters", "{}"),
 
 
 def curves_csv(runs):
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(("method",) + LOG_FIELDS)
-    for r in runs:
-        for row in r.log:
-            w.writerow([r.name] + ["" if isinstance(row[k], float) and math.isnan(row[k])
-                                   else repr(row[k]) for k in LOG_FIELDS])
-    return buf.getvalue()
+    rows = [{"method": r.name, **row} for r in runs for row in r.log]
+    return format_log(rows, ".csv", ("method",) + LOG_FIELDS)
 
 
 def summary_json(runs, info):

@@ -1,27 +1,28 @@
-"""Deformer: precompute once per mesh and constraint set, then solve for any targets."""
-import time
+"""Deformer: precompute once per mesh and constraint set, then solve for any targets.
+
+The solve is composed of parts that each live in their own module: a start
+(:mod:`srarap_cli.starts`) makes the first :class:`~srarap_cli.state.State`, a driver
+(:mod:`srarap_cli.drivers`) repeats the local/global step (:mod:`srarap_cli.step`) and decides
+when to stop. This class holds what they share: weights, rest edges, the factored Poisson
+matrix and the local step.
+"""
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.sparse import csgraph
 
-from .energy import (
-    accurate_enough,
-    bending_energy,
-    membrane_energy,
-    membrane_from_covariance,
-)
+from .drivers import DRIVERS, Monitor
+from .energy import bending_energy, membrane_energy
 from .global_step import PoissonSolver
 from .local_step import METHODS
 from .operators import cell_graph
-from .quaternion import IDENTITY, to_matrix
 from .rest_edges import RestEdges
+from .settings import DEFAULTS
+from .starts import STARTS
+from .step import LocalGlobalStep
 
-LOG_FIELDS = ("iteration", "membrane", "bending", "total", "rel_change", "max_move", "seconds")
-
-
-class NumericalError(RuntimeError):
-    """The solve produced non-finite values."""
+DEFAULT_START = "laplacian"
+DEFAULT_DRIVER = "plain"
 
 
 @dataclass
@@ -32,41 +33,42 @@ class DeformResult:
     ----------
     positions : (n, 3) float array
     rotors : (n, 4) float array, unit quaternions (w, x, y, z) of the vertex cells
-    log : list of dict, one per iteration (0 is the Laplacian-editing start), keys LOG_FIELDS
+    log : list of dict, one per iteration (0 is the start), keys ``solve_log.LOG_FIELDS``
     converged : bool, relative energy change fell below ``tol``
     iterations : int, local/global iterations run
-    full_energy : dict or None
-        ``membrane``, ``bending``, ``total`` of the returned positions and rotors when they
-        differ from the last log row (multiresolution: the log follows the coarse mesh)
-    stages : dict, seconds per stage of a multiresolution solve (empty otherwise)
-    coarse : dict or None, multiresolution only: ``vertices`` (coarse count), ``of`` (the
-        solved mesh's count) and ``cache_hit`` (the coarse mesh came from the cache)
+    coarse_log : bool (class attribute), the log follows another mesh than the result
     """
 
+    coarse_log = False
     positions: np.ndarray
     rotors: np.ndarray
     log: list = field(default_factory=list)
     converged: bool = False
     iterations: int = 0
-    full_energy: dict = None
-    stages: dict = field(default_factory=dict)
-    coarse: dict = None
 
     def energies(self):
         """``membrane``, ``bending`` and ``total`` energy of the returned shape."""
-        source = self.log[-1] if self.full_energy is None else self.full_energy
-        return {k: source[k] for k in ("membrane", "bending", "total")}
+        return {k: self.log[-1][k] for k in ("membrane", "bending", "total")}
 
     @property
     def energy(self):
         return self.energies()["total"]
 
+    @property
+    def seconds(self):
+        """Wall time of the solve."""
+        return self.log[-1]["seconds"]
+
+    def report_lines(self):
+        """Extra lines a command prints about how the result was obtained (none here)."""
+        return []
+
 
 class Deformer:
     """SR-ARAP deformation of one triangle mesh with one set of constrained vertices.
 
-    Builds the edge weights, factors the Poisson matrix and lays out the rotor system once;
-    :meth:`solve` then runs the local/global iteration for any target positions.
+    Builds the edge weights, rest edges, the Poisson factorization and the local step once;
+    :meth:`solve` then runs a start and a driver for any targets.
 
     Parameters
     ----------
@@ -82,9 +84,14 @@ class Deformer:
         default: fastest to a given energy on the benchmarks), the paper's system itself,
         per-cell relaxation sweeps, or classic ARAP (no bending term).
     sweeps : int, relaxation sweeps per iteration for ``sr-relax``
+    prepare : bool, factor and build the local step now (False: on first use, for a
+        multiresolution solver that may only need the fine mesh's energy)
+
+    Defaults are those of :mod:`srarap_cli.settings`.
 
     Attributes
     ----------
+    fixed : (j,) int array, every vertex whose position is held: constrained and auto_fixed
     auto_fixed : (j,) int array
         Vertices kept at rest because nothing could move them: unreferenced vertices and
         every connected part that holds no constrained vertex.
@@ -100,8 +107,9 @@ class Deformer:
     (True, True)
     """
 
-    def __init__(self, V, F, constrained, *, alpha=0.14, feedback=0.2,
-                 weights="cotan-clamped", area=None, method="sr-linear-sym", sweeps=2):
+    def __init__(self, V, F, constrained, *, alpha=DEFAULTS["alpha"],
+                 feedback=DEFAULTS["feedback"], weights=DEFAULTS["weights"], area=None,
+                 method=DEFAULTS["method"], sweeps=DEFAULTS["sweeps"], prepare=True):
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
         if not alpha > 0:
@@ -113,120 +121,103 @@ class Deformer:
         self.weights = weights
         self.graph = cell_graph(self.V, self.F, weights)
         self.alpha = float(alpha)
+        self.feedback = float(feedback)
         self.area = self.graph.area if area is None else float(area)
+        self.method, self.sweeps = method, sweeps
         self.constrained = np.asarray(constrained, dtype=np.int64).ravel()
-        mask = np.zeros(len(self.V), dtype=bool)
-        mask[self.constrained] = True
+        self._mask = np.zeros(len(self.V), dtype=bool)
+        self._mask[self.constrained] = True
         self.warnings = weight_warnings(self.graph)
-        self.auto_fixed, notes = unanchored(self.graph, mask)
+        self.auto_fixed, notes = unanchored(self.graph, self._mask)
         self.warnings += notes
-        mask[self.auto_fixed] = True
-        self._fixed = np.flatnonzero(mask)
-        self._slot = np.searchsorted(self._fixed, self.constrained)
+        self._mask[self.auto_fixed] = True
+        self.fixed = np.flatnonzero(self._mask)
+        self._slot = np.searchsorted(self.fixed, self.constrained)
         self.edges = RestEdges(self.graph, self.V)
-        self._energy_floor = 1e-14 * max(float(self.graph.c @ self.edges.q_sq), 1e-300)
-        self.poisson = PoissonSolver(self.graph, mask)
-        step_class = METHODS[method]
-        extra = {"sweeps": sweeps} if method == "sr-relax" else {}
-        self.method = method
-        self.local_step = step_class(self.edges, mask, self.alpha * self.area, feedback, **extra)
-        self._bending_alpha = self.alpha if step_class.bending else 0.0
+        self.energy_floor = 1e-14 * max(float(self.graph.c @ self.edges.q_sq), 1e-300)
+        self._bending_alpha = self.alpha if METHODS[method].bending else 0.0
+        self._poisson = self._local_step = None
+        if prepare:
+            self.prepare()
 
-    def _fixed_targets(self, targets):
-        full = self.V[self._fixed].copy()
+    def prepare(self):
+        """Factor the Poisson matrix and build the local step, if not done yet."""
+        if self._poisson is None:
+            self._poisson = PoissonSolver(self.graph, self._mask)
+            extra = {"sweeps": self.sweeps} if self.method == "sr-relax" else {}
+            self._local_step = METHODS[self.method](self.edges, self._mask,
+                                                    self.alpha * self.area, self.feedback,
+                                                    **extra)
+        return self
+
+    @property
+    def poisson(self):
+        """The factored Poisson matrix (global step)."""
+        return self.prepare()._poisson
+
+    @property
+    def local_step(self):
+        """The method's local step (see :mod:`srarap_cli.local_step`)."""
+        return self.prepare()._local_step
+
+    def fixed_targets(self, targets):
+        """Positions (j, 3) of every held vertex (``fixed``): ``targets`` for the constrained
+        ones, rest positions for the rest."""
+        full = self.V[self.fixed].copy()
         full[self._slot] = targets
         return full
 
-    def solve(self, targets, *, max_iter=200, tol=1e-6, initial=None, callback=None,
-              time_limit=None):
+    def bending(self, R):
+        """The bending energy of rotors ``R`` (n, 4) (0 for classic ARAP)."""
+        return bending_energy(self.graph, R, self._bending_alpha, self.area)
+
+    def energy(self, P, R):
+        """Energy terms of any positions ``P`` (n, 3) with rotors ``R`` (n, 4), from per-edge
+        residuals (accurate near rigid motions): dict ``membrane``, ``bending``, ``total``."""
+        membrane = membrane_energy(self.graph, self.edges.q, P, R)
+        bending = self.bending(R)
+        return {"membrane": membrane, "bending": bending, "total": membrane + bending}
+
+    def best_rotors(self, P, R_prev):
+        """One local step: the rotors (n, 4) the method gives positions ``P`` (n, 3), with
+        ``R_prev`` as the previous rotors (feedback, hemispheres)."""
+        return self.local_step.step(self.edges.cross(P),
+                                    self.edges.stretch(P) if self.local_step.needs_stretch
+                                    else None, R_prev)
+
+    def step_for(self, targets, tol=DEFAULTS["tol"]):
+        """The :class:`~srarap_cli.step.LocalGlobalStep` of one set of targets."""
+        return LocalGlobalStep(self, targets, tol)
+
+    def solve(self, targets, *, max_iter=DEFAULTS["max_iter"], tol=DEFAULTS["tol"],
+              time_limit=DEFAULTS["time_limit"], initial=None, callback=None, start=None,
+              driver=DEFAULT_DRIVER):
         """Deform toward ``targets`` for the constrained vertices.
 
         Parameters
         ----------
         targets : (k, 3) float array, in the order of ``constrained``
         max_iter : int >= 0, local/global iterations at most
-        tol : float, stop when ``|E_k - E_{k-1}| <= tol * E_{k-1}``
-        initial : (positions (n, 3), rotors (n, 4)), optional warm start; default is
-            Laplacian editing (identity rotors, one Poisson solve)
-        callback : callable(dict), called with each log row
+        tol : float, stop when ``|E_k - E_{k-1}| <= tol * |E_{k-1}|``
         time_limit : float, optional; stop (not converged) once this many seconds have passed
+        initial : (positions (n, 3), rotors (n, 4)), optional, for the ``warm`` start
+        callback : callable(dict), called with each log row
+        start : str, a name in :data:`srarap_cli.starts.STARTS`; default ``warm`` when
+            ``initial`` is given, else Laplacian editing
+        driver : str, a name in :data:`srarap_cli.drivers.DRIVERS`
 
         Returns
         -------
         DeformResult
         """
-        start = time.perf_counter()
-        targets = np.asarray(targets, dtype=float).reshape(-1, 3)
-        fixed_targets = self._fixed_targets(targets)
-        poisson = self.poisson.bind(fixed_targets)
-        if initial is None:
-            R = np.tile(IDENTITY, (len(self.V), 1))
-            P = poisson(self.edges.rotated_divergence(R))
-        else:
-            P = np.array(initial[0], dtype=float)
-            R = np.array(initial[1], dtype=float)
-            P[self._fixed] = fixed_targets
-        result = DeformResult(P, R)
-        state = self._state(P, R)
-        self._record(result, state, None, tol, start, callback)
-        for k in range(1, max_iter + 1):
-            R = self.local_step.step(state["S"], state["s"], R)
-            Rm = to_matrix(R)
-            P_new = poisson(self.edges.rotated_divergence(R, Rm))
-            state = self._state(P_new, R, Rm)
-            row = self._record(result, state, P, tol, start, callback)
-            P = P_new
-            result.iterations = k
-            if row["rel_change"] <= tol:
-                result.converged = True
-                break
-            if time_limit is not None and row["seconds"] >= time_limit:
-                break
-        result.positions, result.rotors = P, R
-        return result
-
-    def _state(self, P, R, Rm=None):
-        """What an iteration knows about positions ``P`` with rotors ``R``: covariances (the
-        next local step's input; per-cell stretch only for the steps that use it), the total
-        stretch (for the energy) and rotation matrices."""
-        S = self.edges.cross(P)
-        if self.local_step.needs_stretch:
-            s = self.edges.stretch(P)
-            total = float(s.sum())
-        else:
-            s, total = None, self.edges.stretch_total(P)
-        return {"P": P, "R": R, "S": S, "s": s, "stretch_total": total,
-                "Rm": to_matrix(R) if Rm is None else Rm}
-
-    def _membrane(self, st, tol):
-        """Membrane energy from the covariances when that is accurate enough for ``tol``,
-        else from the per-edge residuals (near-rigid shapes, ``tol`` 0)."""
-        fast = membrane_from_covariance(st["S"], st["stretch_total"], st["Rm"])
-        if accurate_enough(fast, st["stretch_total"], tol):
-            return fast
-        return membrane_energy(self.graph, self.edges.q, st["P"], st["R"])
-
-    def _record(self, result, st, P_prev, tol, start, callback):
-        P = st["P"]
-        membrane = self._membrane(st, tol)
-        bending = bending_energy(self.graph, st["R"], self._bending_alpha, self.area)
-        total = membrane + bending
-        if not np.isfinite(total):
-            raise NumericalError(f"energy became non-finite at iteration {len(result.log)}")
-        if P_prev is None:
-            rel, move = float("nan"), 0.0
-        else:
-            previous = result.log[-1]["total"]
-            rel = abs(total - previous) / max(abs(previous), self._energy_floor)
-            d = P - P_prev
-            move = float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d), initial=0.0)))
-        row = {"iteration": len(result.log), "membrane": membrane, "bending": bending,
-               "total": total, "rel_change": rel, "max_move": move,
-               "seconds": time.perf_counter() - start}
-        result.log.append(row)
-        if callback is not None:
-            callback(row)
-        return row
+        self.prepare()
+        monitor = Monitor(max_iter=max_iter, tol=tol, time_limit=time_limit,
+                          callback=callback, energy_floor=self.energy_floor)
+        step = self.step_for(targets, tol)
+        name = start or ("warm" if initial is not None else DEFAULT_START)
+        state = DRIVERS[driver](step, STARTS[name](step, initial), monitor)
+        return DeformResult(state.positions, state.rotors, monitor.log, monitor.converged,
+                            monitor.iterations)
 
 
 def unanchored(graph, constrained):
@@ -265,25 +256,3 @@ def weight_warnings(graph):
                    "not bounded below and the solve may not settle; use --weights "
                    "cotan-clamped (default) or uniform")
     return out
-
-
-def deform(V, F, constrained, targets, **options):
-    """One-shot deformation: build a :class:`Deformer` and solve once.
-
-    Parameters
-    ----------
-    V : (n, 3) float array
-    F : (f, 3) int array
-    constrained : (k,) int array
-    targets : (k, 3) float array
-    **options : ``alpha``, ``feedback``, ``weights``, ``area`` go to the Deformer;
-        ``max_iter``, ``tol``, ``initial``, ``callback`` to :meth:`Deformer.solve`
-
-    Returns
-    -------
-    DeformResult
-    """
-    solve_keys = {"max_iter", "tol", "initial", "callback"}
-    solve_opts = {k: v for k, v in options.items() if k in solve_keys}
-    build_opts = {k: v for k, v in options.items() if k not in solve_keys}
-    return Deformer(V, F, constrained, **build_opts).solve(targets, **solve_opts)

@@ -7,3 +7,11 @@ class InputError(ValueError):
 
 class OutputError(OSError):
     """An output file could not be written."""
+
+
+class NumericalError(RuntimeError):
+    """The solve produced non-finite values."""
+
+
+class SingularSystemError(RuntimeError):
+    """A factorization met a singular matrix (for example a part with no constraint)."""

@@ -1,28 +1,8 @@
 """Global step: positions from rotors by a Poisson solve, factored once (paper section 5)."""
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-
-class SingularSystemError(RuntimeError):
-    """A factorization met a singular matrix (for example a part with no constraint)."""
-
-
-def factor(A, symmetric):
-    """LU-factor a sparse square matrix; returns a callable ``solve(b)``.
-
-    A symmetric matrix gets a symmetric fill-reducing ordering, which roughly halves the
-    fill of SuperLU's default column ordering on mesh Laplacians, and SuperLU's symmetric
-    mode (diagonal pivots preferred): with the same fill, its triangular solves ran 1.5 to 4
-    times faster on the benchmark meshes (decimated-max Laplacian: 2.0 -> 0.5 ms).
-    """
-    options = {"SymmetricMode": True} if symmetric else {}
-    try:
-        lu = spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A" if symmetric else "COLAMD",
-                       options=options)
-    except RuntimeError as exc:  # SuperLU reports an exactly singular matrix this way
-        raise SingularSystemError(str(exc)) from exc
-    return lu.solve
+from .linalg import factor
 
 
 class PoissonSolver:

@@ -1,26 +1,14 @@
 """From a mesh and its constraints to the deformed mesh: the path every command shares."""
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .deformer import Deformer, DeformResult
 from .mesh_checks import mesh_warnings, solvable_faces
-from .multires import MultiresDeformer, coarse_size
+from .oneshot import make_deformer
 from .operators import mesh_area
 from .quaternion import IDENTITY
 from .region import restrict
-
-DEFAULTS = {"alpha": 0.14, "feedback": 0.2, "max_iter": 1000, "tol": 1e-6,
-            "weights": "cotan-clamped", "method": "sr-linear-sym", "sweeps": 2,
-            "multires": "auto"}
-
-
-def settings(file_settings, overrides):
-    """Defaults, then the handle file's ``solver`` section, then explicit options (not None)."""
-    out = dict(DEFAULTS)
-    out.update(file_settings)
-    out.update({k: v for k, v in overrides.items() if v is not None})
-    return out
+from .settings import resolve, stage_options
 
 
 @dataclass
@@ -76,19 +64,10 @@ def _labels(constraints, full_ids):
 
 
 def build_deformer(p, opts, cache=None):
-    """The deformer of a :class:`Problem` with resolved settings ``opts``: a
-    :class:`Deformer`, or a :class:`MultiresDeformer` when ``opts["multires"]`` asks for
-    one (``cache``: folder for its coarse meshes)."""
-    common = {"alpha": opts["alpha"], "feedback": opts["feedback"], "weights": opts["weights"],
-              "area": p.area, "method": opts["method"], "sweeps": opts["sweeps"]}
-    size = coarse_size(opts.get("multires"), len(p.V))
-    if size is None:
-        deformer = Deformer(p.V, p.F, p.ids, **common)
-        if opts.get("multires") not in (None, "auto", "off"):
-            deformer.warnings.append(f"multires {opts['multires']} is not below the mesh's "
-                                     f"{len(p.V)} vertices: solved directly")
-        return deformer
-    return MultiresDeformer(p.V, p.F, p.ids, p.labels, size=size, cache=cache, **common)
+    """The solver of a :class:`Problem` with resolved settings ``opts`` (see
+    :func:`~srarap_cli.oneshot.make_deformer`; ``cache``: folder for coarse meshes)."""
+    return make_deformer(p.V, p.F, p.ids, p.labels, area=p.area, cache=cache,
+                         **stage_options(opts, "setup"), multires=opts.get("multires"))
 
 
 def scatter(mesh, p, positions, constraints, constraint_targets=None):
@@ -110,23 +89,22 @@ def deform_mesh(mesh, constraints, callback=None, cache=None, **overrides):
     constraints : Constraints
     callback : callable(dict), optional, receives each log row
     cache : str, optional, folder for multiresolution coarse meshes
-    **overrides : alpha, feedback, max_iter, tol, weights, method, sweeps, multires
+    **overrides : any solver setting (see :mod:`srarap_cli.settings`); None means the
+        handle file's value or the default
 
     Returns
     -------
     deformed : Mesh, same vertices and faces, new positions and normals
-    result : DeformResult, positions/rotors of the whole mesh
+    result : DeformResult (or MultiresResult), positions/rotors of the whole mesh
     warnings : list of str
     """
-    opts = settings(constraints.solver, overrides)
+    opts = resolve(constraints.solver, overrides)
     p = problem(mesh, constraints)
     deformer = build_deformer(p, opts, cache)
-    sub_result = deformer.solve(p.targets, max_iter=opts["max_iter"], tol=opts["tol"],
-                                callback=callback)
+    sub_result = deformer.solve(p.targets, callback=callback, **stage_options(opts, "solve"))
     positions = scatter(mesh, p, sub_result.positions, constraints)
     rotors = np.tile(IDENTITY, (len(positions), 1))
     rotors[p.vertices] = sub_result.rotors
-    result = DeformResult(positions, rotors, sub_result.log, sub_result.converged,
-                          sub_result.iterations, sub_result.full_energy, sub_result.stages, sub_result.coarse)
+    result = replace(sub_result, positions=positions, rotors=rotors)
     notes = mesh_warnings(mesh.vertices, mesh.triangles()[0]) + list(deformer.warnings)
     return mesh.with_vertices(positions), result, notes

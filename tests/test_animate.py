@@ -19,8 +19,8 @@ from srarap_cli.errors import InputError
 from srarap_cli.handles import parse_handles
 from srarap_cli.keyframes import slerp
 from srarap_cli.mesh_io import read_mesh
-from srarap_cli.pipeline import settings
 from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli.settings import resolve
 
 BASE = {"box": {"min": [-2, -2, -0.01], "max": [2, 2, 0.01]}, "fixed": True}
 TOP_BOX = {"min": [-2, -2, 5.99], "max": [2, 2, 6.01]}
@@ -37,7 +37,7 @@ def twist_doc(degrees=240, frames=24):
 def run_frames(mesh, doc, n, feedback, iters=20):
     c = parse_handles(doc, mesh.vertices)
     frames = []
-    state = Animator(mesh, c, settings({}, {"feedback": feedback})).run(
+    state = Animator(mesh, c, resolve({}, {"feedback": feedback})).run(
         n, iters_per_frame=iters, tol=1e-6, on_frame=lambda f, P, s: frames.append(P))
     return c, frames, state.rows
 
@@ -66,7 +66,7 @@ def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames(rings, multir
                       for g, box in (("base", BASE["box"]), ("top", TOP_BOX))}}
     c = parse_handles(doc, mesh.vertices)
     frames = []
-    animator = Animator(mesh, c, settings({}, {"multires": multires}))
+    animator = Animator(mesh, c, resolve({}, {"multires": multires}))
     assert (multires == "off") == (animator.deformer.__class__.__name__ == "Deformer")
     animator.run(4, iters_per_frame=3000, tol=1e-13, on_frame=lambda f, P, s: frames.append(P))
     q1 = from_axis_angle([1, 1, 0], 90)

@@ -6,7 +6,7 @@ import scipy.sparse as sp
 from helpers import ends, random_rotation, symmetric_tube, tube
 from scipy.spatial.transform import Rotation
 
-from srarap_cli.deformer import Deformer, deform
+from srarap_cli import Deformer, deform
 from srarap_cli.quaternion import IDENTITY, from_axis_angle, multiply, to_matrix
 
 ALPHA = 0.14

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from helpers import ends, tube
 
-from srarap_cli.deformer import Deformer, deform
+from srarap_cli import Deformer, deform
 from srarap_cli.local_step import METHODS
 from srarap_cli.local_step.linear_sym import symmetric_weights
 from srarap_cli.local_step.membrane import membrane_matrices

@@ -1,6 +1,4 @@
 """``srarap animate``: keyframed handles -> one deformed mesh per frame."""
-import hashlib
-import json
 import math
 import os
 import sys
@@ -8,23 +6,15 @@ import time
 
 import click
 
-from ..animation import FRAME_FIELDS, Animator, FrameState
+from ..animation import FRAME_FIELDS, Animator, FrameState, fingerprint
 from ..errors import InputError, OutputError
 from ..handles import load_handles
 from ..limits import check_solve
-from ..local_step import METHODS
 from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
-from ..multires import MultiresDeformer
-from ..pipeline import settings
-from ..solve_log import LOG_FORMATS
-from .common import (
-    check_output_path,
-    guarded,
-    multires_line,
-    multires_options,
-    solver_options,
-)
+from ..settings import click_options, resolve
+from ..solve_log import LOG_FORMATS, format_log
+from .common import cache_option, check_output_path, guarded
 
 STATE_NAME = ".srarap-animate-state.npz"
 
@@ -42,14 +32,12 @@ STATE_NAME = ".srarap-animate-state.npz"
               help="Local/global iterations per frame at most.")
 @click.option("--log", "log", help="Per-frame log: .csv or .jsonl.")
 @click.option("--resume", is_flag=True, help="Continue after the last complete frame.")
-@click.option("--method", type=click.Choice(tuple(METHODS)),
-              help="Local step. [default: sr-linear-sym]")
-@solver_options
-@multires_options
+@click_options(exclude=("time_limit",))
+@cache_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress, summary or warnings.")
 @guarded
-def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, method, alpha,
-            feedback, max_iter, tol, weights, sweeps, multires, cache, quiet):
+def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, overrides, cache,
+            quiet):
     """Deform MESH through the keyframes of HANDLES, writing one mesh per frame.
 
     Each frame starts from the previous one (positions and rotors) and iterates until --tol or
@@ -64,13 +52,10 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, m
     check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices, fps=fps)
     n_frames = frames or math.floor(constraints.last_key_frame) + 1
-    opts = settings(constraints.solver, {"alpha": alpha, "feedback": feedback, "tol": tol,
-                                         "weights": weights, "method": method,
-                                         "sweeps": sweeps, "max_iter": max_iter,
-                                         "multires": multires})
-    fingerprint = _fingerprint(mesh, handles, opts, n_frames, fps, iters_per_frame, pattern)
+    opts = resolve(constraints.solver, overrides)
+    run_id = fingerprint((mesh, handles), opts, n_frames, fps, iters_per_frame, pattern)
     state_path = os.path.join(folder, STATE_NAME)
-    state = _resume_state(state_path, fingerprint) if resume else None
+    state = _resume_state(state_path, run_id) if resume else None
     animator = Animator(source, constraints, opts, cache=cache)
     progress = _Progress(n_frames, enabled=not quiet and sys.stderr.isatty())
 
@@ -80,16 +65,16 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, m
         progress.update(f + 1)
 
     final = animator.run(n_frames, iters_per_frame=iters_per_frame, tol=opts["tol"],
-                         state=state, on_frame=write_frame, fingerprint=fingerprint)
+                         state=state, on_frame=write_frame, fingerprint=run_id)
     progress.close()
     rows = final.rows if final is not None else []
     if log is not None:
-        commit_files([(log, _log_text(rows, os.path.splitext(log)[1].lower()).encode())])
+        text = format_log(rows, os.path.splitext(log)[1].lower(), FRAME_FIELDS)
+        commit_files([(log, text.encode())])
     os.unlink(state_path) if os.path.exists(state_path) else None
     if not quiet:
-        d = animator.deformer
-        if isinstance(d, MultiresDeformer):
-            click.echo(multires_line(d.info, d.stages), err=True)
+        for line in animator.last_result.report_lines() if animator.last_result else []:
+            click.echo(line, err=True)
         stalled = sum(not r["converged"] for r in rows)
         seconds = sum(r["seconds"] for r in rows)
         click.echo(f"srarap animate: {len(rows)} frames ({stalled} stopped at "
@@ -121,15 +106,6 @@ def _check_pattern(pattern):
     return folder
 
 
-def _fingerprint(mesh, handles, opts, n_frames, fps, iters, pattern):
-    h = hashlib.sha256()
-    for path in (mesh, handles):
-        with open(path, "rb") as fh:
-            h.update(hashlib.sha256(fh.read()).digest())
-    h.update(json.dumps([opts, n_frames, fps, iters, pattern], sort_keys=True).encode())
-    return h.hexdigest()
-
-
 def _resume_state(path, fingerprint):
     if not os.path.exists(path):
         return None
@@ -138,16 +114,6 @@ def _resume_state(path, fingerprint):
         raise InputError(f"{path}: resume state of another run (different inputs or options); "
                          "delete it or run without --resume")
     return state
-
-
-def _log_text(rows, suffix):
-    if suffix == ".csv":
-        lines = [",".join(FRAME_FIELDS)]
-        lines += [",".join(repr(r[k]) if isinstance(r[k], float) else str(r[k]).lower()
-                           if isinstance(r[k], bool) else str(r[k]) for k in FRAME_FIELDS)
-                  for r in rows]
-        return "\n".join(lines) + "\n"
-    return "".join(json.dumps({k: r[k] for k in FRAME_FIELDS}) + "\n" for r in rows)
 
 
 class _Progress:

@@ -10,10 +10,14 @@ from ..handles import load_handles
 from ..limits import check_solve
 from ..mesh_io import read_mesh
 from ..mesh_io.commit import commit_files
-from ..pipeline import problem, settings
-from .common import guarded, solver_options
+from ..pipeline import problem
+from ..settings import click_options, resolve
+from .common import guarded
 
 CHOICES = ALL_METHODS + (IGL,)
+# bench measures how fast each method approaches the minimum, so it runs far past the usual
+# stopping point unless told otherwise (the handle file's tol and max_iter do not apply)
+OWN_DEFAULTS = {"tol": 1e-9, "max_iter": 100000}
 
 
 @click.command("bench")
@@ -25,15 +29,14 @@ CHOICES = ALL_METHODS + (IGL,)
               show_default=True, help="Seconds each method may run.")
 @click.option("-o", "--output", "out", type=click.Path(file_okay=False),
               help="Folder for curves.csv, summary.json and energy.png (created if missing).")
-@solver_options
+@click_options(exclude=("method", "multires", "time_limit"), defaults=OWN_DEFAULTS)
 @guarded
-def bench(mesh, handles, methods, time_budget, out, alpha, feedback, max_iter, tol, weights,
-          sweeps):
+def bench(mesh, handles, methods, time_budget, out, overrides):
     """Run each method on MESH + HANDLES from the same start and compare them.
 
     Reports per-iteration time, iterations and seconds to come within 1% and 0.1% of the lowest
     SR energy reached, final energy and constraint error; libigl's ARAP is timed in the same run.
-    Methods stop at --tol (default here 1e-9), --max-iter or the time budget.
+    Methods stop at --tol, --max-iter or the time budget.
     """
     names = [m.strip() for m in methods.split(",") if m.strip()]
     unknown = [m for m in names if m not in CHOICES]
@@ -45,12 +48,12 @@ def bench(mesh, handles, methods, time_budget, out, alpha, feedback, max_iter, t
     source = read_mesh(mesh)
     check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
-    opts = settings(constraints.solver, {"alpha": alpha, "feedback": feedback,
-                                         "weights": weights, "sweeps": sweeps})
+    stop = {k: v if overrides[k] is None else overrides[k] for k, v in OWN_DEFAULTS.items()}
+    opts = resolve(constraints.solver, {k: v for k, v in overrides.items() if k not in stop})
     p = problem(source, constraints)
     runs = run_methods(p.V, p.F, p.ids, p.targets, names, settings=opts,
-                       time_budget=time_budget, max_iter=max_iter or 100000,
-                       tol=1e-9 if tol is None else tol, sweeps=opts["sweeps"])
+                       time_budget=time_budget, max_iter=stop["max_iter"], tol=stop["tol"],
+                       sweeps=opts["sweeps"])
     click.echo(table(runs), nl=False)
     if out is not None:
         info = {"mesh": mesh, "handles": handles, "vertices": len(p.V),

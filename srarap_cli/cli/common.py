@@ -10,22 +10,7 @@ import click
 import numpy as np
 
 from .. import exit_codes
-from ..deformer import NumericalError
-from ..errors import InputError, OutputError
-from ..global_step import SingularSystemError
-from ..multires.size import AUTO_SIZE, AUTO_THRESHOLD, parse_size
-from ..operators import WEIGHT_KINDS
-
-STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
-               "factor": "fine setup", "coarse_solve": "coarse solve", "transfer": "transfer",
-               "fine_solve": "fine solve"}
-
-
-def multires_line(info, stages):
-    """``srarap: multires: 5002 of 737986 vertices; simplify 1.20 s, ...`` for stderr."""
-    cached = " (coarse mesh from cache)" if info["cache_hit"] else ""
-    times = ", ".join(f"{STAGE_NAMES.get(k, k)} {v:.2f} s" for k, v in stages.items())
-    return f"srarap: multires: {info['vertices']} of {info['of']} vertices{cached}; {times}"
+from ..errors import InputError, NumericalError, OutputError, SingularSystemError
 
 
 def fail(code, message):
@@ -98,51 +83,5 @@ def check_output_path(path, allowed, what):
         raise OutputError(f"{path}: is a folder")
 
 
-_SOLVER_OPTIONS = [
-    click.option("--alpha", type=click.FloatRange(min=0, min_open=True),
-                 help="Bending weight (energy uses alpha * total area). [default: 0.14]"),
-    click.option("--feedback", type=click.FloatRange(min=0),
-                 help="Pull of each rotor toward its previous value (paper's eps). "
-                      "[default: 0.2]"),
-    click.option("--max-iter", type=click.IntRange(min=0),
-                 help="Local/global iterations at most. [default: 1000]"),
-    click.option("--tol", type=click.FloatRange(min=0),
-                 help="Stop when the relative energy change is at most this. [default: 1e-6]"),
-    click.option("--weights", type=click.Choice(WEIGHT_KINDS),
-                 help="Edge weights. [default: cotan-clamped]"),
-    click.option("--sweeps", type=click.IntRange(min=1),
-                 help="Relaxation sweeps per iteration for sr-relax. [default: 2]"),
-]
-
-
-def _multires_setting(_ctx, _param, value):
-    if value is None:
-        return None
-    try:
-        return parse_size(value)
-    except ValueError as exc:
-        raise click.BadParameter(str(exc)) from None
-
-
-_MULTIRES_OPTIONS = [
-    click.option("--multires", callback=_multires_setting, metavar="N|P%|off|auto",
-                 help="Solve on a simplified mesh of N vertices (or P% of them) and carry the "
-                      f"result to the full mesh. [default: auto = off below "
-                      f"{AUTO_THRESHOLD} vertices, else {AUTO_SIZE}]"),
-    click.option("--cache", type=click.Path(file_okay=False),
-                 help="Folder keeping simplified meshes between runs (multires)."),
-]
-
-
-def multires_options(func):
-    """``--multires`` and ``--cache`` (None: file or default)."""
-    for option in reversed(_MULTIRES_OPTIONS):
-        func = option(func)
-    return func
-
-
-def solver_options(func):
-    """The solver settings every solving subcommand accepts (None: file or default)."""
-    for option in reversed(_SOLVER_OPTIONS):
-        func = option(func)
-    return func
+cache_option = click.option("--cache", type=click.Path(file_okay=False),
+                            help="Folder keeping simplified meshes between runs (multires).")

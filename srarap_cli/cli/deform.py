@@ -7,19 +7,13 @@ from .. import exit_codes
 from ..distortion import vertex_distortion
 from ..handles import load_handles
 from ..limits import check_solve
-from ..local_step import METHODS
 from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
-from ..pipeline import deform_mesh, settings
+from ..pipeline import deform_mesh
+from ..preview import preview_png
+from ..settings import click_options, resolve
 from ..solve_log import LOG_FORMATS, format_log
-from .common import (
-    check_output_path,
-    guarded,
-    multires_line,
-    multires_options,
-    solver_options,
-)
-from .render import preview_png
+from .common import cache_option, check_output_path, guarded
 
 
 @click.command("deform")
@@ -29,17 +23,14 @@ from .render import preview_png
               help="Deformed mesh to write: .obj, .ply or .off.")
 @click.option("--log", "log", type=click.Path(dir_okay=False),
               help="Per-iteration energy log: .csv or .jsonl.")
-@solver_options
-@click.option("--method", type=click.Choice(tuple(METHODS)),
-              help="Local step (see README). [default: sr-linear-sym]")
-@multires_options
+@click_options()
+@cache_option
 @click.option("--preview", help="Also write a PNG: rest and deformed shape, handles coloured.")
 @click.option("--write-distortion", is_flag=True,
               help="Add a per-vertex 'distortion' property to PLY output.")
 @click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
 @guarded
-def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, method, sweeps,
-           multires, cache, preview, write_distortion, quiet):
+def deform(mesh, handles, out, log, overrides, cache, preview, write_distortion, quiet):
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
@@ -58,8 +49,6 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, met
     source = read_mesh(mesh)
     check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
-    overrides = {"alpha": alpha, "feedback": feedback, "max_iter": max_iter, "tol": tol,
-                 "weights": weights, "method": method, "sweeps": sweeps, "multires": multires}
     deformed, result, notes = deform_mesh(source, constraints, cache=cache, **overrides)
     if write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
@@ -74,9 +63,9 @@ def deform(mesh, handles, out, log, alpha, feedback, max_iter, tol, weights, met
     if not quiet:
         for note in notes + lost:
             click.echo(f"srarap: warning: {note}", err=True)
-        if result.stages:
-            click.echo(multires_line(result.coarse, result.stages), err=True)
-        click.echo(_summary(result, settings(constraints.solver, overrides), out), err=True)
+        for line in result.report_lines():
+            click.echo(line, err=True)
+        click.echo(_summary(result, resolve(constraints.solver, overrides), out), err=True)
     if not result.converged:
         raise SystemExit(exit_codes.NOT_CONVERGED)
 
@@ -87,9 +76,8 @@ def _summary(result, opts, out):
              f"NOT converged after {result.iterations} iterations "
              f"(relative change {last['rel_change']:.3g} > tol {opts['tol']:g})")
     e = result.energies()
-    where = "" if result.full_energy is None else f"coarse energy {last['total']:.6g}; full "
+    where = f"coarse energy {last['total']:.6g}; full " if result.coarse_log else ""
     return (f"srarap deform: {state}; {where}energy {e['total']:.6g} (membrane "
-            f"{e['membrane']:.6g}, bending {e['bending']:.6g}); "
-            f"{sum(result.stages.values()) if result.stages else last['seconds']:.2f} s; "
+            f"{e['membrane']:.6g}, bending {e['bending']:.6g}); {result.seconds:.2f} s; "
             f"wrote {out}")
 

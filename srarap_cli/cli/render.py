@@ -6,11 +6,11 @@ import os
 import click
 import numpy as np
 
-from ..distortion import vertex_distortion
 from ..handles import load_handles
 from ..mesh_io import read_mesh
 from ..mesh_io.commit import commit_files
-from ..render import VIEWS, face_colors, render_png
+from ..preview import preview_png
+from ..render import VIEWS
 from .common import check_output_path, guarded
 
 
@@ -22,29 +22,6 @@ def parse_size(text):
     if not (16 <= w <= 8000 and 16 <= h <= 8000):
         raise click.BadParameter(f"{text!r}: width and height must be 16 to 8000 pixels")
     return w, h
-
-
-def preview_png(mesh, rest=None, constraints=None, color="shade", layout="side", view="iso",
-                size=(800, 600)):
-    """PNG bytes of ``mesh`` (and its ``rest`` shape), handles coloured or distortion mapped."""
-    F = mesh.triangles()[0]
-    groups = list(constraints.groups.values()) if constraints is not None else None
-    colorbar = None
-    if color == "distortion":
-        d = vertex_distortion(rest.vertices, mesh.vertices, F)
-        vmax = max(float(d.max()), 1e-12)
-        colors = face_colors(F, scalar=d, vmax=vmax)
-        colorbar = ("distortion (relative strain)", vmax)
-    else:
-        colors = face_colors(F, groups)
-    current = [(mesh.vertices, F, colors, 1.0)]
-    if rest is None:
-        panels = [current]
-    else:
-        rest_item = (rest.vertices, F, face_colors(F, groups), 1.0)
-        panels = [[rest_item], current] if layout == "side" else \
-            [[(rest.vertices, F, face_colors(F), 0.25)] + current]
-    return render_png(panels, size, view, colorbar)
 
 
 @click.command("render")

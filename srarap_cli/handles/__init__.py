@@ -12,17 +12,13 @@ import numpy as np
 import yaml
 
 from ..errors import InputError
-from ..local_step import METHODS
-from ..multires.size import parse_size
-from ..operators import WEIGHT_KINDS
+from ..settings import parse_mapping
 from .fields import Context
 from .formats import read_def, read_sel
 from .keys import parse_track
 from .selectors import SELECTOR_KEYS, select
 from .transforms import ACTION_KEYS, targets
 
-SOLVER_KEYS = ("alpha", "feedback", "max_iter", "tol", "weights", "method", "sweeps",
-               "multires")
 TOP_KEYS = ("groups", "region", "solver")
 ANIMATION_KEYS = ("keyframes", "easing")
 
@@ -38,7 +34,7 @@ class Constraints:
     groups : dict of group name -> (j,) int array of its vertex ids
     region : (r,) int array or None, vertices allowed to move (region of interest);
         everything else stays at rest
-    solver : dict, solver settings given in the file (keys from SOLVER_KEYS)
+    solver : dict, solver settings given in the file (see :mod:`srarap_cli.settings`)
     tracks : list of (slots, rest, Track): keyframed groups, ``slots`` indexing ``ids``;
         ``targets`` holds their pose at frame 0
     """
@@ -128,7 +124,8 @@ def parse_handles(doc, V, path="<handles>", base=".", fps=None):
         region = select(rctx, rctx.mapping(doc["region"], "region", SELECTOR_KEYS), V, base)
     merged_ids, merged = _merge(ctx, names, ids, tgts, V)
     return Constraints(ids=merged_ids, targets=merged, groups=dict(zip(names, ids)),
-                       region=region, solver=_solver(ctx.at("solver"), doc.get("solver", {})),
+                       region=region, solver=parse_mapping(doc.get("solver", {}), "solver",
+                                            ctx.at("solver").error),
                        tracks=_tracks(ctx, tracks, dict(zip(names, ids)), merged_ids, V))
 
 
@@ -162,35 +159,6 @@ def _merge(ctx, names, ids, tgts, V):
         raise ctx.error(f"vertex {all_ids[k]} is in groups {names[owner[lead[k]]]!r} and "
                         f"{names[owner[k]]!r} with different targets")
     return all_ids[first], all_t[first]
-
-
-def _solver(ctx, spec):
-    spec = ctx.mapping(spec, "solver", SOLVER_KEYS)
-    out = {}
-    if "alpha" in spec:
-        out["alpha"] = ctx.number(spec["alpha"], "alpha", 0, strict=True)
-    if "feedback" in spec:
-        out["feedback"] = ctx.number(spec["feedback"], "feedback", 0)
-    if "max_iter" in spec:
-        out["max_iter"] = ctx.integer(spec["max_iter"], "max_iter", 0)
-    if "tol" in spec:
-        out["tol"] = ctx.number(spec["tol"], "tol", 0)
-    if "weights" in spec:
-        if spec["weights"] not in WEIGHT_KINDS:
-            raise ctx.error(f"weights must be one of {', '.join(WEIGHT_KINDS)}")
-        out["weights"] = spec["weights"]
-    if "method" in spec:
-        if spec["method"] not in METHODS:
-            raise ctx.error(f"method must be one of {', '.join(METHODS)}")
-        out["method"] = spec["method"]
-    if "sweeps" in spec:
-        out["sweeps"] = ctx.integer(spec["sweeps"], "sweeps", 1)
-    if "multires" in spec:
-        try:
-            out["multires"] = parse_size(spec["multires"])
-        except ValueError as exc:
-            raise ctx.error(f"multires {exc}") from None
-    return out
 
 
 def _from_sel(path, V):

@@ -9,6 +9,7 @@ symmetric positive definite, solved by :class:`~.rotor_system.RotorSystem`.
 """
 import numpy as np
 
+from .feedback import paper_feedback
 from .rotor_system import RotorSystem
 
 
@@ -22,5 +23,5 @@ class LinearRotorStep(RotorSystem):
         graph = edges.graph
         scale = (graph.degree + feedback).astype(float)
         super().__init__(edges, constrained, sigma=scale, tau=scale * alpha_area,
-                         phi=np.full(graph.n, alpha_area * feedback),
+                         phi=paper_feedback(graph, alpha_area, feedback),
                          omega=np.full(graph.I.size, alpha_area))

@@ -9,6 +9,7 @@ neighbour times eps, as in the paper's row). Same handle-rotor rule and normaliz
 """
 import numpy as np
 
+from .feedback import proximal_feedback
 from .rotor_system import RotorSystem
 
 
@@ -28,6 +29,6 @@ class SymmetricRotorStep(RotorSystem):
         graph = edges.graph
         W = symmetric_weights(graph)
         row_sum = graph.cell_sum(W)
-        prox = alpha_area * feedback / graph.degree.clip(min=1)
+        prox = proximal_feedback(graph, alpha_area, feedback)
         super().__init__(edges, constrained, sigma=np.ones(graph.n),
                          tau=alpha_area * row_sum + prox, phi=prox, omega=alpha_area * W)

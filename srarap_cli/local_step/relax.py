@@ -12,6 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..quaternion import align_hemisphere
+from .feedback import feedback_pull, proximal_feedback
 from .linear_sym import symmetric_weights
 from .membrane import membrane_matrices
 
@@ -101,7 +102,7 @@ class RelaxRotorStep:
         graph = edges.graph
         W = symmetric_weights(graph)
         self._W = sp.csr_matrix((alpha_area * W, (graph.I, graph.J)), shape=(graph.n,) * 2)
-        self._phi = alpha_area * feedback / graph.degree.clip(min=1)
+        self._phi = proximal_feedback(graph, alpha_area, feedback)
         self._rows = [(c, self._W[c]) for c in colour_classes(graph)]
         self.sweeps = int(sweeps)
 
@@ -110,6 +111,6 @@ class RelaxRotorStep:
         R = R_prev.copy()
         for _ in range(self.sweeps):
             for cls, W_rows in self._rows:
-                b = W_rows @ R + self._phi[cls, None] * R_prev[cls]
+                b = W_rows @ R + feedback_pull(self._phi[cls], R_prev[cls])
                 R[cls] = align_hemisphere(best_unit_rotor(lam[cls], Q[cls], b, R[cls]), R[cls])
         return R

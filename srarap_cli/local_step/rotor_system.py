@@ -18,8 +18,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..global_step import factor
+from ..linalg import factor
 from ..quaternion import normalize
+from .constrained_rotors import constrained_rotors
+from .feedback import feedback_pull
 from .membrane import membrane_matrices
 
 CG_RTOL = 1e-10
@@ -76,18 +78,18 @@ class RotorSystem:
         nf = self.free.size
         data = np.concatenate([self._off_vals, D[self.free].ravel()])[self._order]
         A = sp.csr_matrix((data, self._indices, self._indptr), shape=(4 * nf, 4 * nf))
-        b = self.phi[self.free, None] * R_prev[self.free] + self._free_to_fixed @ R_fixed
+        b = feedback_pull(self.phi[self.free], R_prev[self.free]) + self._free_to_fixed @ R_fixed
         return A, b.ravel()
 
     def step(self, S, s, R_prev):
-        """New unit rotors: handle rotors from their own rows (neighbours' previous rotors),
-        then one solve for all free rotors."""
+        """New unit rotors: constrained rotors from their own rows (section 6.2), then one
+        solve for all free rotors."""
         D = self.diagonal_blocks(S, s)
         R = R_prev.copy()
         if self.fixed.size:
-            rhs = self._fixed_rows @ R_prev + self.phi[self.fixed, None] * R_prev[self.fixed]
-            R[self.fixed] = normalize(np.linalg.solve(D[self.fixed], rhs[..., None])[..., 0],
-                                      R_prev[self.fixed])
+            R[self.fixed] = constrained_rotors(
+                D[self.fixed], self._fixed_rows @ R_prev,
+                feedback_pull(self.phi[self.fixed], R_prev[self.fixed]), R_prev[self.fixed])
         if self.free.size:
             A, b = self.free_system(D, R_prev, R[self.fixed])
             sol = self._solve(A, b, R_prev[self.free].ravel())

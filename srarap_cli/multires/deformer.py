@@ -1,32 +1,63 @@
 """Multiresolution SR-ARAP (paper section 7): solve on a coarse subset mesh, spread its
 rotors harmonically over the full mesh, finish with one Poisson solve."""
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..deformer import (
-    Deformer,
-    DeformResult,
-    NumericalError,
-    unanchored,
-    weight_warnings,
-)
-from ..energy import bending_energy, membrane_energy
-from ..operators import cell_graph, mesh_area
+from ..deformer import Deformer, DeformResult
+from ..errors import NumericalError
 from ..quaternion import IDENTITY
-from ..rest_edges import RestEdges
+from ..settings import DEFAULTS
 from .cache import coarse_mesh
 from .dirichlet import DirichletSolver
-from .transfer import group_rotors, handle_rotors, spread_rotors
+from .transfer import group_rotors, orient_group_rotors, spread_rotors
+
+STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
+               "factor": "fine setup", "coarse_solve": "coarse solve", "transfer": "transfer",
+               "fine_solve": "fine solve"}
+
+
+@dataclass
+class MultiresResult(DeformResult):
+    """A :class:`DeformResult` whose ``log`` follows the coarse solve, plus:
+
+    Attributes
+    ----------
+    full_energy : dict, ``membrane``, ``bending``, ``total`` of the returned full-resolution
+        positions and rotors
+    stages : dict, seconds per stage (see STAGE_NAMES)
+    coarse : dict, ``vertices`` (coarse count), ``of`` (full count), ``cache_hit``
+    """
+
+    coarse_log = True
+    full_energy: dict = field(default_factory=dict)
+    stages: dict = field(default_factory=dict)
+    coarse: dict = field(default_factory=dict)
+
+    def energies(self):
+        return dict(self.full_energy)
+
+    @property
+    def seconds(self):
+        return sum(self.stages.values())
+
+    def report_lines(self):
+        """``srarap: multires: 5002 of 737986 vertices; simplify 1.20 s, ...``"""
+        info = self.coarse
+        cached = " (coarse mesh from cache)" if info["cache_hit"] else ""
+        times = ", ".join(f"{STAGE_NAMES.get(k, k)} {v:.2f} s" for k, v in self.stages.items())
+        return [f"srarap: multires: {info['vertices']} of {info['of']} vertices{cached}; {times}"]
 
 
 class MultiresDeformer:
     """Same interface as :class:`~srarap_cli.deformer.Deformer`, solved through a coarse mesh.
 
     Precomputes once: the coarse mesh (simplified, or read from ``cache``), the coarse
-    :class:`Deformer`, and one factorization of the fine Laplacian with Dirichlet rows at the
-    coarse, constrained and immovable vertices, which serves both the rotor transfer and
-    the final Poisson solve.
+    :class:`Deformer`, the fine :class:`Deformer` (weights, rest edges, immovable vertices and
+    the energy of the full mesh; it factors nothing unless it iterates), and one
+    factorization of the fine Laplacian with Dirichlet rows at the coarse, constrained and
+    immovable vertices, which serves both the rotor transfer and the final Poisson solve.
 
     Parameters
     ----------
@@ -40,8 +71,8 @@ class MultiresDeformer:
 
     Attributes
     ----------
-    coarse : CoarseMesh; coarse_deformer : Deformer; stages : dict of precompute seconds;
-    cache_hit : bool; warnings : list of str
+    coarse : CoarseMesh; coarse_deformer, fine : Deformer; stages : dict of precompute
+    seconds; cache_hit : bool; warnings : list of str
 
     Examples
     --------
@@ -66,14 +97,16 @@ class MultiresDeformer:
         groups = [self.constrained[self.labels == g] for g in range(self.n_groups)]
         self.coarse, self.cache_hit, notes = coarse_mesh(self.V, self.F, size, groups, cache)
         self.stages = {"simplify": time.perf_counter() - start}
-        self.area = mesh_area(self.V, self.F) if area is None else float(area)
+        mark = time.perf_counter()
+        self.fine = Deformer(self.V, self.F, self.constrained, area=area, prepare=False,
+                             **options)
+        self.area = self.fine.area
+        fine_setup = time.perf_counter() - mark
         self._build_coarse(options)
         mark = time.perf_counter()
-        fixed_notes = self._build_fine()
-        self.stages["factor"] = time.perf_counter() - mark
-        self.alpha = self.coarse_deformer.alpha
-        self._bending_alpha = self.alpha if self.coarse_deformer.local_step.bending else 0.0
-        self.warnings = (weight_warnings(self.graph) + fixed_notes + notes
+        self._build_transfer()
+        self.stages["factor"] = fine_setup + time.perf_counter() - mark
+        self.warnings = (self.fine.warnings + notes
                          + [f"multires: {w}" for w in self.coarse.warnings])
 
     @property
@@ -93,25 +126,21 @@ class MultiresDeformer:
                                         area=self.area, **options)
         self.stages["coarse_precompute"] = time.perf_counter() - start
 
-    def _build_fine(self):
-        """Dirichlet set (coarse, constrained and immovable vertices) and its factorization."""
-        self.graph = cell_graph(self.V, self.F, self.coarse_deformer.weights)
+    def _build_transfer(self):
+        """Dirichlet set (coarse, held and immovable vertices) and its factorization."""
         known = np.zeros(len(self.V), dtype=bool)
-        known[self.constrained] = True
-        self.auto_fixed, notes = unanchored(self.graph, known)  # as the direct solve would
-        known[self.auto_fixed] = True
+        known[self.fine.fixed] = True
         known[self.coarse.vertices] = True
         self._known = np.flatnonzero(known)
         self._row = np.full(len(self.V), -1)
         self._row[self._known] = np.arange(self._known.size)
-        self.edges = RestEdges(self.graph, self.V)
-        self.solver = DirichletSolver(self.graph.laplacian, self._known)
-        return notes
+        self.solver = DirichletSolver(self.fine.graph.laplacian, self._known)
 
-    def solve(self, targets, *, max_iter=200, tol=1e-6, initial=None, callback=None,
-              time_limit=None):
-        """Deform toward ``targets``; see :meth:`Deformer.solve`. ``log`` holds the coarse
-        iterations, ``full_energy`` the full mesh's energy, ``stages`` the seconds per stage."""
+    def solve(self, targets, *, max_iter=DEFAULTS["max_iter"], tol=DEFAULTS["tol"],
+              time_limit=DEFAULTS["time_limit"], initial=None, callback=None):
+        """Deform toward ``targets``; see :meth:`Deformer.solve`. Returns a
+        :class:`MultiresResult`: ``log`` holds the coarse iterations, ``full_energy`` the
+        full mesh's energy, ``stages`` the seconds per stage."""
         start = time.perf_counter()
         targets = np.asarray(targets, dtype=float).reshape(-1, 3)
         cv = self.coarse.vertices
@@ -125,30 +154,29 @@ class MultiresDeformer:
         R = spread_rotors(self.solver, self._known_rotors(targets, coarse.rotors))
         stages["transfer"] = time.perf_counter() - mark
         mark = time.perf_counter()
-        P = self.solver.solve(self._known_positions(targets, coarse.positions),
-                              self.edges.rotated_divergence(R))
+        P = self.solver.solve(self.known_positions(targets, coarse.positions),
+                              self.fine.edges.rotated_divergence(R))
         stages["fine_solve"] = time.perf_counter() - mark
-        membrane = membrane_energy(self.graph, self.edges.q, P, R)
-        bending = bending_energy(self.graph, R, self._bending_alpha, self.area)
-        if not (np.isfinite(P).all() and np.isfinite(membrane + bending)):
+        energy = self.fine.energy(P, R)
+        if not (np.isfinite(P).all() and np.isfinite(energy["total"])):
             raise NumericalError("the full-resolution solve produced non-finite values")
-        return DeformResult(P, R, coarse.log, coarse.converged, coarse.iterations,
-                            full_energy={"membrane": membrane, "bending": bending,
-                                         "total": membrane + bending}, stages=stages,
-                            coarse=self.info)
+        return MultiresResult(P, R, coarse.log, coarse.converged, coarse.iterations,
+                              full_energy=energy, stages=stages, coarse=self.info)
 
     def _known_rotors(self, targets, coarse_rotors):
         out = np.tile(IDENTITY, (self._known.size, 1))
         rot, determined = group_rotors(self.V[self.constrained], targets, self.labels,
                                        self.n_groups)
-        out[self._row[self.constrained]] = handle_rotors(
+        out[self._row[self.constrained]] = orient_group_rotors(
             rot, determined, self.labels, self.n_groups, self._coarse_slots,
             coarse_rotors[self.coarse_deformer.constrained])
         out[self._row[self.coarse.vertices]] = coarse_rotors
-        out[self._row[self.auto_fixed]] = IDENTITY
+        out[self._row[self.fine.auto_fixed]] = IDENTITY
         return out
 
-    def _known_positions(self, targets, coarse_positions):
+    def known_positions(self, targets, coarse_positions):
+        """Positions (j, 3) of the transfer's Dirichlet vertices: targets for the
+        constrained ones, the coarse solve's for coarse vertices, rest for the others."""
         out = self.V[self._known].copy()
         out[self._row[self.coarse.vertices]] = coarse_positions
         out[self._row[self.constrained]] = targets

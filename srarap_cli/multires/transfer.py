@@ -1,5 +1,6 @@
 """Carry rotors from the coarse mesh to the fine mesh (paper eq 7.4) and name the rotors
-of handle vertices the coarse mesh left out."""
+of handle vertices the coarse mesh left out (each group's own rotation: not the paper's
+section 6.2, which solves constrained rotors from their cells, see ``local_step``)."""
 import numpy as np
 
 from ..quaternion import IDENTITY, align_hemisphere, from_matrix, normalize
@@ -78,7 +79,7 @@ def _label_sum(values, labels, n_groups):
                      for c in range(values.shape[1])], axis=1)
 
 
-def handle_rotors(rotors, determined, labels, n_groups, coarse_slots, coarse_rotors):
+def orient_group_rotors(rotors, determined, labels, n_groups, coarse_slots, coarse_rotors):
     """Rotors for all constrained vertices, on the hemisphere of the coarse solution.
 
     Each group's rotor is flipped toward the sum of the coarse rotors of its vertices that

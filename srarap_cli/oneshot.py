@@ -1,0 +1,66 @@
+"""Choose, build and run a solver from settings: direct or multiresolution."""
+from .deformer import Deformer
+from .multires import MultiresDeformer, coarse_size
+from .settings import DEFAULTS, check_keywords, stage_options
+
+
+def make_deformer(V, F, constrained, labels=None, *, area=None, cache=None, **options):
+    """The solver for the settings ``options``: a :class:`Deformer`, or a
+    :class:`MultiresDeformer` when ``multires`` asks for one.
+
+    Parameters
+    ----------
+    V : (n, 3) float array; F : (f, 3) int array; constrained : (k,) int array
+    labels : (k,) int array, optional, handle group of each constrained vertex
+    area : float, optional, ``A`` of the energy (default: the mesh's area)
+    cache : str, optional, folder for multiresolution coarse meshes
+    **options : setup and build settings (see :mod:`srarap_cli.settings`)
+    """
+    check_keywords(options, ("setup", "build"), "make_deformer")
+    setup = stage_options(options, "setup")
+    setting = options.get("multires", DEFAULTS["multires"])
+    size = coarse_size(setting, len(V))
+    if size is None:
+        deformer = Deformer(V, F, constrained, area=area, **setup)
+        if setting not in (None, "auto", "off"):
+            deformer.warnings.append(f"multires {setting} is not below the mesh's "
+                                     f"{len(V)} vertices: solved directly")
+        return deformer
+    return MultiresDeformer(V, F, constrained, labels, size=size, cache=cache, area=area,
+                            **setup)
+
+
+def deform(V, F, constrained, targets, *, initial=None, callback=None, cache=None,
+           **settings):
+    """One-shot deformation: build the solver and solve once.
+
+    Parameters
+    ----------
+    V : (n, 3) float array
+    F : (f, 3) int array
+    constrained : (k,) int array
+    targets : (k, 3) float array
+    initial : (positions, rotors), optional warm start
+    callback : callable(dict), optional, receives each log row
+    cache : str, optional, folder for multiresolution coarse meshes
+    **settings : any solver setting of :mod:`srarap_cli.settings` (``alpha``, ``tol``,
+        ``time_limit``, ``multires``, ...); the defaults are the CLI's
+
+    Returns
+    -------
+    DeformResult
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    >>> r = deform(V, [[0, 1, 2], [1, 3, 2]], [0, 1, 2, 3], V + 1.0, time_limit=5)
+    >>> r.converged
+    True
+    """
+    check_keywords(settings, ("setup", "build", "solve"), "deform")
+    deformer = make_deformer(V, F, constrained, cache=cache,
+                             **{k: v for k, v in settings.items()
+                                if k not in stage_options(settings, "solve")})
+    return deformer.solve(targets, initial=initial, callback=callback,
+                          **stage_options(settings, "solve"))

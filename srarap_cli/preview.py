@@ -1,0 +1,26 @@
+"""A picture of a deformed mesh: rest and deformed shape, handles coloured or strain mapped."""
+from .distortion import vertex_distortion
+from .render import face_colors, render_png
+
+
+def preview_png(mesh, rest=None, constraints=None, color="shade", layout="side", view="iso",
+                size=(800, 600)):
+    """PNG bytes of ``mesh`` (and its ``rest`` shape), handles coloured or distortion mapped."""
+    F = mesh.triangles()[0]
+    groups = list(constraints.groups.values()) if constraints is not None else None
+    colorbar = None
+    if color == "distortion":
+        d = vertex_distortion(rest.vertices, mesh.vertices, F)
+        vmax = max(float(d.max()), 1e-12)
+        colors = face_colors(F, scalar=d, vmax=vmax)
+        colorbar = ("distortion (relative strain)", vmax)
+    else:
+        colors = face_colors(F, groups)
+    current = [(mesh.vertices, F, colors, 1.0)]
+    if rest is None:
+        panels = [current]
+    else:
+        rest_item = (rest.vertices, F, face_colors(F, groups), 1.0)
+        panels = [[rest_item], current] if layout == "side" else \
+            [[(rest.vertices, F, face_colors(F), 0.25)] + current]
+    return render_png(panels, size, view, colorbar)
