@@ -62,6 +62,7 @@ class Animator:
         self.constraints = constraints
         self.problem = problem(mesh, constraints)
         self.deformer = build_deformer(self.problem, opts, cache)
+        self.solve_options = {"accel": opts["accel"], "start": opts["start"]}
         self.last_result = None
 
     def run(self, frames, *, iters_per_frame, tol, state=None, on_frame=None, fingerprint=""):
@@ -81,6 +82,7 @@ class Animator:
             frame_targets = self.constraints.targets_at(float(f))
             targets = self.problem.targets_for(frame_targets)
             result = self.deformer.solve(targets, max_iter=iters_per_frame, tol=tol,
+                                         **self.solve_options,
                                          initial=None if P is None else (P, R))
             self.last_result = result
             # the solver's own rotors against the previous frame's: negative means a sign flip

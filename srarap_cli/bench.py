@@ -85,7 +85,7 @@ def _igl_row(scorer, P, k, seconds, P_prev):
     e = scorer.energy(P, R)["membrane"]
     move = 0.0 if P_prev is None else float(np.linalg.norm(P - P_prev, axis=1).max())
     return {"iteration": k, "membrane": e, "bending": 0.0, "total": e, "rel_change": float("nan"),
-            "max_move": move, "seconds": seconds}
+            "max_move": move, "seconds": seconds, "step": "start" if P_prev is None else "plain"}
 
 
 def _summarize(runs, ids, targets):

@@ -14,6 +14,7 @@ from scipy.sparse import csgraph
 from .drivers import DRIVERS, Monitor
 from .energy import bending_energy, membrane_energy
 from .global_step import PoissonSolver
+from .group_rotations import connected_groups
 from .local_step import METHODS
 from .operators import cell_graph
 from .rest_edges import RestEdges
@@ -21,8 +22,8 @@ from .settings import DEFAULTS
 from .starts import STARTS
 from .step import LocalGlobalStep
 
-DEFAULT_START = "laplacian"
-DEFAULT_DRIVER = "plain"
+# the ``accel`` setting names a driver
+ACCEL_DRIVERS = {"anderson": "anderson", "none": "plain"}
 
 
 @dataclass
@@ -84,6 +85,9 @@ class Deformer:
         default: fastest to a given energy on the benchmarks), the paper's system itself,
         per-cell relaxation sweeps, or classic ARAP (no bending term).
     sweeps : int, relaxation sweeps per iteration for ``sr-relax``
+    labels : (k,) int array, optional, handle group of each constrained vertex (the
+        rotation-aware start fits one rotation per group); default: the connected patches
+        the constrained vertices form
     prepare : bool, factor and build the local step now (False: on first use, for a
         multiresolution solver that may only need the fine mesh's energy)
 
@@ -92,6 +96,7 @@ class Deformer:
     Attributes
     ----------
     fixed : (j,) int array, every vertex whose position is held: constrained and auto_fixed
+    constrained_slots : (k,) int array, where each constrained vertex sits in ``fixed``
     auto_fixed : (j,) int array
         Vertices kept at rest because nothing could move them: unreferenced vertices and
         every connected part that holds no constrained vertex.
@@ -109,7 +114,8 @@ class Deformer:
 
     def __init__(self, V, F, constrained, *, alpha=DEFAULTS["alpha"],
                  feedback=DEFAULTS["feedback"], weights=DEFAULTS["weights"], area=None,
-                 method=DEFAULTS["method"], sweeps=DEFAULTS["sweeps"], prepare=True):
+                 method=DEFAULTS["method"], sweeps=DEFAULTS["sweeps"], labels=None,
+                 prepare=True):
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
         if not alpha > 0:
@@ -132,7 +138,9 @@ class Deformer:
         self.warnings += notes
         self._mask[self.auto_fixed] = True
         self.fixed = np.flatnonzero(self._mask)
-        self._slot = np.searchsorted(self.fixed, self.constrained)
+        self.constrained_slots = np.searchsorted(self.fixed, self.constrained)
+        self.labels = (connected_groups(self.graph.laplacian, self.constrained)
+                       if labels is None else np.asarray(labels, dtype=np.int64).ravel())
         self.edges = RestEdges(self.graph, self.V)
         self.energy_floor = 1e-14 * max(float(self.graph.c @ self.edges.q_sq), 1e-300)
         self._bending_alpha = self.alpha if METHODS[method].bending else 0.0
@@ -164,7 +172,7 @@ class Deformer:
         """Positions (j, 3) of every held vertex (``fixed``): ``targets`` for the constrained
         ones, rest positions for the rest."""
         full = self.V[self.fixed].copy()
-        full[self._slot] = targets
+        full[self.constrained_slots] = targets
         return full
 
     def bending(self, R):
@@ -190,21 +198,24 @@ class Deformer:
         return LocalGlobalStep(self, targets, tol)
 
     def solve(self, targets, *, max_iter=DEFAULTS["max_iter"], tol=DEFAULTS["tol"],
-              time_limit=DEFAULTS["time_limit"], initial=None, callback=None, start=None,
-              driver=DEFAULT_DRIVER):
+              time_limit=DEFAULTS["time_limit"], accel=DEFAULTS["accel"],
+              start=DEFAULTS["start"], initial=None, callback=None, driver=None):
         """Deform toward ``targets`` for the constrained vertices.
 
         Parameters
         ----------
         targets : (k, 3) float array, in the order of ``constrained``
         max_iter : int >= 0, local/global iterations at most
-        tol : float, stop when ``|E_k - E_{k-1}| <= tol * |E_{k-1}|``
+        tol : float, stop when ``|E_k - E_{k-1}| <= tol * |E_{k-1}|`` (and the step moved
+            no vertex by more than ``sqrt(tol)`` of the bounding-box diagonal)
         time_limit : float, optional; stop (not converged) once this many seconds have passed
-        initial : (positions (n, 3), rotors (n, 4)), optional, for the ``warm`` start
+        accel : {"anderson", "none"}, the driver: accelerated or plain iteration
+        start : str, a name in :data:`srarap_cli.starts.STARTS` (``harmonic``,
+            ``laplacian``); ignored when ``initial`` is given (warm start)
+        initial : (positions (n, 3), rotors (n, 4)), optional warm start
         callback : callable(dict), called with each log row
-        start : str, a name in :data:`srarap_cli.starts.STARTS`; default ``warm`` when
-            ``initial`` is given, else Laplacian editing
-        driver : str, a name in :data:`srarap_cli.drivers.DRIVERS`
+        driver : str, optional, a name in :data:`srarap_cli.drivers.DRIVERS`; overrides
+            ``accel``
 
         Returns
         -------
@@ -212,10 +223,11 @@ class Deformer:
         """
         self.prepare()
         monitor = Monitor(max_iter=max_iter, tol=tol, time_limit=time_limit,
-                          callback=callback, energy_floor=self.energy_floor)
+                          callback=callback, energy_floor=self.energy_floor,
+                          scale=float(np.linalg.norm(np.ptp(self.V, axis=0))))
         step = self.step_for(targets, tol)
-        name = start or ("warm" if initial is not None else DEFAULT_START)
-        state = DRIVERS[driver](step, STARTS[name](step, initial), monitor)
+        first = STARTS["warm" if initial is not None else start](step, initial)
+        state = DRIVERS[driver or ACCEL_DRIVERS[accel]](step, first, monitor)
         return DeformResult(state.positions, state.rotors, monitor.log, monitor.converged,
                             monitor.iterations)
 

@@ -21,12 +21,13 @@ def make_deformer(V, F, constrained, labels=None, *, area=None, cache=None, **op
     setting = options.get("multires", DEFAULTS["multires"])
     size = coarse_size(setting, len(V))
     if size is None:
-        deformer = Deformer(V, F, constrained, area=area, **setup)
+        deformer = Deformer(V, F, constrained, area=area, labels=labels, **setup)
         if setting not in (None, "auto", "off"):
             deformer.warnings.append(f"multires {setting} is not below the mesh's "
                                      f"{len(V)} vertices: solved directly")
         return deformer
     return MultiresDeformer(V, F, constrained, labels, size=size, cache=cache, area=area,
+                            mode=options.get("multires_mode", DEFAULTS["multires_mode"]),
                             **setup)
 
 

@@ -67,7 +67,7 @@ def build_deformer(p, opts, cache=None):
     """The solver of a :class:`Problem` with resolved settings ``opts`` (see
     :func:`~srarap_cli.oneshot.make_deformer`; ``cache``: folder for coarse meshes)."""
     return make_deformer(p.V, p.F, p.ids, p.labels, area=p.area, cache=cache,
-                         **stage_options(opts, "setup"), multires=opts.get("multires"))
+                         **stage_options(opts, "setup"), **stage_options(opts, "build"))
 
 
 def scatter(mesh, p, positions, constraints, constraint_targets=None):

@@ -118,10 +118,20 @@ SETTINGS = (
     Setting("time_limit", "float", None,
             "Stop (not converged) once the solve has run this many seconds.", "solve",
             minimum=0, strict=True, metavar="SECONDS"),
+    Setting("accel", "choice", "anderson",
+            "Outer iteration: Anderson acceleration with an energy safeguard, or none (plain "
+            "local/global fixed-point iteration).", "solve", choices=("anderson", "none")),
+    Setting("start", "choice", "harmonic",
+            "First iterate: the handles' rotations spread harmonically (harmonic) or identity "
+            "rotors (laplacian editing).", "solve", choices=("harmonic", "laplacian")),
     Setting("multires", "size", "auto",
             "Solve on a simplified mesh of N vertices (or P% of them) and carry the result to "
             f"the full mesh; auto = off below {AUTO_THRESHOLD} vertices, else {AUTO_SIZE}.",
             "build", metavar="N|P%|off|auto"),
+    Setting("multires_mode", "choice", "refine",
+            "With multires: refine = the transferred result starts full-resolution iterations "
+            "run to tol; transfer = stop after the transfer (the paper's approximation).",
+            "build", choices=("refine", "transfer")),
 )
 BY_NAME = {s.name: s for s in SETTINGS}
 DEFAULTS = {s.name: s.default for s in SETTINGS}

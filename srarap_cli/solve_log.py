@@ -5,7 +5,8 @@ import json
 import math
 
 LOG_FORMATS = (".csv", ".jsonl", ".ndjson")
-LOG_FIELDS = ("iteration", "membrane", "bending", "total", "rel_change", "max_move", "seconds")
+LOG_FIELDS = ("iteration", "membrane", "bending", "total", "rel_change", "max_move", "seconds",
+              "step")
 
 
 def format_log(rows, suffix, fields=LOG_FIELDS):

@@ -15,6 +15,7 @@ class State:
     rotation_matrices : (n, 3, 3) float array, the rotors as matrices
     covariances : (n, 3, 3) float array, ``S_i`` of the positions (the next local step's input)
     stretch : (n,) float array or None, per-cell ``s_i`` (only for steps that use it)
+    stretch_total : float, ``sum_i s_i``
     membrane, bending : float, the energy terms of (positions, rotors)
     iteration : int, 0 for a start
     """
@@ -24,6 +25,7 @@ class State:
     rotation_matrices: np.ndarray
     covariances: np.ndarray
     stretch: np.ndarray
+    stretch_total: float
     membrane: float
     bending: float
     iteration: int = 0

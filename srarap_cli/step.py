@@ -28,16 +28,22 @@ class LocalGlobalStep:
         self._poisson = deformer.poisson.bind(self.fixed_targets)
 
     def __call__(self, state):
-        R = self.deformer.local_step.step(state.covariances, state.stretch, state.rotors)
+        R = self.local(state)
         Rm = to_matrix(R)
         return self.state(self.positions(R, Rm), R, Rm, state.iteration + 1)
+
+    def local(self, state):
+        """Local step: new rotors (n, 4) for the state's positions (its rotors are the
+        previous ones: feedback, constrained rotors, hemispheres)."""
+        return self.deformer.local_step.step(state.covariances, state.stretch, state.rotors)
 
     def positions(self, R, Rm=None):
         """Global step: the positions (n, 3) that best fit rotors ``R`` (n, 4)."""
         return self._poisson(self.deformer.edges.rotated_divergence(R, Rm))
 
-    def state(self, P, R, Rm=None, iteration=0):
-        """The :class:`State` of positions ``P`` with rotors ``R`` (energy included)."""
+    def state(self, P, R, Rm=None, iteration=0, energy=True):
+        """The :class:`State` of positions ``P`` with rotors ``R``; ``energy=False`` leaves
+        the energy terms NaN (a driver that only needs the covariances)."""
         d = self.deformer
         S = d.edges.cross(P)
         if d.local_step.needs_stretch:
@@ -45,9 +51,21 @@ class LocalGlobalStep:
             stretch_total = float(s.sum())
         else:
             s, stretch_total = None, d.edges.stretch_total(P)
-        Rm = to_matrix(R) if Rm is None else Rm
+        if not energy:
+            return State(P, R, Rm, S, s, stretch_total, float("nan"), float("nan"), iteration)
+        return self._evaluate(P, R, to_matrix(R) if Rm is None else Rm, S, s, stretch_total,
+                              iteration)
+
+    def with_rotors(self, state, R, iteration=None):
+        """The state's positions with other rotors ``R``: covariances reused, energy anew."""
+        return self._evaluate(state.positions, R, to_matrix(R), state.covariances,
+                              state.stretch, state.stretch_total,
+                              state.iteration if iteration is None else iteration)
+
+    def _evaluate(self, P, R, Rm, S, s, stretch_total, iteration):
+        d = self.deformer
         membrane = membrane_from_covariance(S, stretch_total, Rm)
         if not accurate_enough(membrane, stretch_total, self.tol):
             # near-rigid shapes or tol 0: the cancelling form is too coarse, sum residuals
             membrane = membrane_energy(d.graph, d.edges.q, P, R)
-        return State(P, R, Rm, S, s, membrane, d.bending(R), iteration)
+        return State(P, R, Rm, S, s, stretch_total, membrane, d.bending(R), iteration)

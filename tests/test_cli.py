@@ -52,7 +52,7 @@ def test_sample_case_converges_and_keeps_uvs_and_polygons(tmp_path):
     with open(log) as fh:
         rows = list(csv.DictReader(fh))
     assert list(rows[0]) == ["iteration", "membrane", "bending", "total", "rel_change",
-                             "max_move", "seconds"]
+                             "max_move", "seconds", "step"]
     assert float(rows[-1]["rel_change"]) <= 1e-6 and "converged" in r.stderr
 
 

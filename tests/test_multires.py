@@ -18,7 +18,8 @@ from srarap_cli.multires import (
 from srarap_cli.multires.cache import coarse_mesh
 from srarap_cli.multires.dirichlet import DirichletSolver
 from srarap_cli.multires.topology import topology_summary
-from srarap_cli.multires.transfer import group_rotors, spread_rotors
+from srarap_cli.group_rotations import group_rotors
+from srarap_cli.multires.transfer import spread_rotors
 from srarap_cli.operators import cell_graph, mesh_area
 from srarap_cli.pipeline import problem
 from srarap_cli.quaternion import rotate, to_matrix
@@ -128,7 +129,7 @@ def test_multires_solve_follows_the_handles_and_logs_its_stages(spot):
     V = spot[0]
     c = load_handles(NOD, V)
     p = problem(read_mesh(SPOT), c)
-    d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500)
+    d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500, mode="transfer")
     r = d.solve(p.targets, max_iter=400)
     assert np.array_equal(r.positions[p.ids], p.targets)
     assert set(r.stages) == {"simplify", "coarse_precompute", "factor", "coarse_solve",
@@ -171,7 +172,7 @@ def test_multires_settings_parse_and_pick_the_direct_solve_for_small_meshes():
 def test_cli_multires_runs_caches_and_gives_identical_files(tmp_path):
     runner = CliRunner()
     args = ["deform", SPOT, NOD, "--multires", "1000", "--cache", str(tmp_path / "cache"),
-            "--max-iter", "40"]
+            "--max-iter", "40", "--multires-mode", "transfer"]
     one = runner.invoke(main, args + ["-o", str(tmp_path / "a.obj")])
     assert one.exit_code in (0, 3), one.output
     assert "srarap: multires: " in one.output and "full energy" in one.output

@@ -46,7 +46,7 @@ def test_a_driver_registered_from_a_test_file_runs_through_the_public_api(bent):
     try:
         d = Deformer(V, F, ids)
         capped = d.solve(T, driver="test-at-most-three", max_iter=50, tol=0)
-        plain = d.solve(T, max_iter=3, tol=0)
+        plain = d.solve(T, accel="none", max_iter=3, tol=0)
     finally:
         DRIVERS.pop("test-at-most-three")
     assert capped.iterations == 3 and len(capped.log) == 4 and not capped.converged
@@ -58,14 +58,14 @@ def test_a_driver_registered_from_a_test_file_runs_through_the_public_api(bent):
 def test_a_start_registered_from_a_test_file_is_used(bent):
     V, F, ids, T = bent
     d = Deformer(V, F, ids)
-    solved = d.solve(T, max_iter=400, tol=1e-10)
+    solved = d.solve(T, max_iter=400, tol=1e-10, accel="none")
 
     def from_answer(step, initial):
         return step.state(solved.positions.copy(), solved.rotors.copy())
 
     register_start("test-answer", from_answer)
     try:
-        again = d.solve(T, start="test-answer", max_iter=5, tol=1e-8)
+        again = d.solve(T, start="test-answer", accel="none", max_iter=5, tol=1e-8)
     finally:
         STARTS.pop("test-answer")
     assert again.log[0]["total"] == pytest.approx(solved.log[-1]["total"], rel=1e-12)
@@ -90,7 +90,7 @@ def test_one_step_is_a_function_of_the_state(bent):
 def test_plain_driver_matches_the_loop_written_out(bent):
     V, F, ids, T = bent
     d = Deformer(V, F, ids)
-    r = d.solve(T, max_iter=7, tol=0)
+    r = d.solve(T, accel="none", start="laplacian", max_iter=7, tol=0)
     step = d.step_for(T, tol=0)
     state = STARTS["laplacian"](step, None)
     for _ in range(7):

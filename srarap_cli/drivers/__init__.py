@@ -6,10 +6,11 @@ of one local/global iteration) from the start ``state`` and hands every iterate 
 answers whether to stop (tolerance, iteration cap, time limit). :data:`DRIVERS` maps names to
 drivers; :func:`register` adds one.
 """
+from .anderson import anderson_iteration
 from .monitor import Monitor
-from .plain import plain
+from .plain import plain_iteration
 
-DRIVERS = {"plain": plain}
+DRIVERS = {"plain": plain_iteration, "anderson": anderson_iteration}
 
 
 def register(name, driver):

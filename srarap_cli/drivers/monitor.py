@@ -12,10 +12,13 @@ class Monitor:
     Parameters
     ----------
     max_iter : int, steps at most
-    tol : float, converged when ``|E_k - E_{k-1}| <= tol * |E_{k-1}|``
+    tol : float, converged when ``|E_k - E_{k-1}| <= tol * |E_{k-1}|`` and no vertex moved
+        more than ``sqrt(tol) * scale`` in that step (an accelerated step can change the
+        shape a lot while the energy barely changes)
     time_limit : float or None, stop (not converged) after this many seconds
     callback : callable(dict) or None, called with each log row
     energy_floor : float, smallest ``|E_{k-1}|`` the relative change divides by
+    scale : float, the mesh's size (bounding-box diagonal)
 
     Attributes
     ----------
@@ -24,8 +27,10 @@ class Monitor:
     iterations : int, steps recorded after the start
     """
 
-    def __init__(self, *, max_iter, tol, time_limit=None, callback=None, energy_floor=0.0):
+    def __init__(self, *, max_iter, tol, time_limit=None, callback=None, energy_floor=0.0,
+                 scale=float("inf")):
         self.max_iter, self.tol, self.time_limit = max_iter, tol, time_limit
+        self.move_tol = np.sqrt(max(tol, 0.0)) * scale
         self.callback, self.energy_floor = callback, energy_floor
         self.log = []
         self.converged = False
@@ -35,9 +40,10 @@ class Monitor:
     def iterations(self):
         return max(len(self.log) - 1, 0)
 
-    def record(self, state, previous=None):
-        """Log ``state`` (``previous``: the iterate it came from, None for the start);
-        returns True when the solve should stop."""
+    def record(self, state, previous=None, kind=None):
+        """Log ``state`` (``previous``: the iterate it came from, None for the start;
+        ``kind``: how the driver made it, default ``start`` or ``plain``); returns True
+        when the solve should stop."""
         total = state.total
         if not np.isfinite(total):
             raise NumericalError(f"energy became non-finite at iteration {len(self.log)}")
@@ -50,13 +56,14 @@ class Monitor:
             move = float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d), initial=0.0)))
         row = {"iteration": len(self.log), "membrane": state.membrane,
                "bending": state.bending, "total": total, "rel_change": rel,
-               "max_move": move, "seconds": time.perf_counter() - self.start}
+               "max_move": move, "seconds": time.perf_counter() - self.start,
+               "step": kind or ("start" if previous is None else "plain")}
         self.log.append(row)
         if self.callback is not None:
             self.callback(row)
         if previous is None:
             return self.max_iter <= 0
-        if rel <= self.tol:
+        if rel <= self.tol and move <= self.move_tol:
             self.converged = True
             return True
         timed_out = self.time_limit is not None and row["seconds"] >= self.time_limit

@@ -1,7 +1,7 @@
 """The plain fixed-point iteration ``x_{k+1} = G(x_k)``: local step, global step, repeat."""
 
 
-def plain(step, state, monitor):
+def plain_iteration(step, state, monitor):
     """Iterate ``step`` until ``monitor`` says stop.
 
     Parameters

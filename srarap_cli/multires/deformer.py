@@ -11,26 +11,31 @@ from ..quaternion import IDENTITY
 from ..settings import DEFAULTS
 from .cache import coarse_mesh
 from .dirichlet import DirichletSolver
-from .transfer import group_rotors, orient_group_rotors, spread_rotors
+from ..group_rotations import group_rotors
+from .transfer import orient_group_rotors, spread_rotors
 
 STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
                "factor": "fine setup", "coarse_solve": "coarse solve", "transfer": "transfer",
-               "fine_solve": "fine solve"}
+               "fine_solve": "fine solve", "fine_iterations": "full-resolution iterations"}
+MODES = ("refine", "transfer")
 
 
 @dataclass
 class MultiresResult(DeformResult):
-    """A :class:`DeformResult` whose ``log`` follows the coarse solve, plus:
+    """A :class:`DeformResult` of a multiresolution solve. Its ``log`` holds the coarse
+    iterations (``step`` prefixed ``coarse-``), then, in ``refine`` mode, the full-resolution
+    ones. Besides:
 
     Attributes
     ----------
+    coarse_log : bool, the log ends with coarse iterations (``transfer`` mode)
     full_energy : dict, ``membrane``, ``bending``, ``total`` of the returned full-resolution
         positions and rotors
     stages : dict, seconds per stage (see STAGE_NAMES)
     coarse : dict, ``vertices`` (coarse count), ``of`` (full count), ``cache_hit``
     """
 
-    coarse_log = True
+    coarse_log: bool = True
     full_energy: dict = field(default_factory=dict)
     stages: dict = field(default_factory=dict)
     coarse: dict = field(default_factory=dict)
@@ -66,6 +71,8 @@ class MultiresDeformer:
     labels : (k,) int array, handle group of each constrained vertex (default: one group)
     size : int, wanted coarse vertex count
     cache : str, optional folder for coarse meshes
+    mode : {"refine", "transfer"}, what follows the transfer: full-resolution iterations to
+        ``tol`` from the transferred result, or nothing (the paper's approximate mode)
     area : float, optional, ``A`` of the energy (default: area of the full mesh)
     **options : alpha, feedback, weights, method, sweeps, as for Deformer
 
@@ -85,8 +92,11 @@ class MultiresDeformer:
     True
     """
 
-    def __init__(self, V, F, constrained, labels=None, *, size, cache=None, area=None,
-                 **options):
+    def __init__(self, V, F, constrained, labels=None, *, size, cache=None, mode="refine",
+                 area=None, **options):
+        if mode not in MODES:
+            raise ValueError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
+        self.mode = mode
         start = time.perf_counter()
         self.V = np.asarray(V, dtype=float)
         self.F = np.asarray(F, dtype=np.int64)
@@ -98,13 +108,15 @@ class MultiresDeformer:
         self.coarse, self.cache_hit, notes = coarse_mesh(self.V, self.F, size, groups, cache)
         self.stages = {"simplify": time.perf_counter() - start}
         mark = time.perf_counter()
-        self.fine = Deformer(self.V, self.F, self.constrained, area=area, prepare=False,
-                             **options)
+        self.fine = Deformer(self.V, self.F, self.constrained, area=area, labels=self.labels,
+                             prepare=False, **options)
         self.area = self.fine.area
         fine_setup = time.perf_counter() - mark
         self._build_coarse(options)
         mark = time.perf_counter()
         self._build_transfer()
+        if mode == "refine":
+            self.fine.prepare()
         self.stages["factor"] = fine_setup + time.perf_counter() - mark
         self.warnings = (self.fine.warnings + notes
                          + [f"multires: {w}" for w in self.coarse.warnings])
@@ -123,7 +135,8 @@ class MultiresDeformer:
         in_coarse = slot[cv] >= 0
         self._coarse_slots = slot[cv][in_coarse]
         self.coarse_deformer = Deformer(self.V[cv], self.coarse.faces, np.flatnonzero(in_coarse),
-                                        area=self.area, **options)
+                                        area=self.area, labels=self.labels[self._coarse_slots],
+                                        **options)
         self.stages["coarse_precompute"] = time.perf_counter() - start
 
     def _build_transfer(self):
@@ -137,19 +150,20 @@ class MultiresDeformer:
         self.solver = DirichletSolver(self.fine.graph.laplacian, self._known)
 
     def solve(self, targets, *, max_iter=DEFAULTS["max_iter"], tol=DEFAULTS["tol"],
-              time_limit=DEFAULTS["time_limit"], initial=None, callback=None):
-        """Deform toward ``targets``; see :meth:`Deformer.solve`. Returns a
-        :class:`MultiresResult`: ``log`` holds the coarse iterations, ``full_energy`` the
-        full mesh's energy, ``stages`` the seconds per stage."""
-        start = time.perf_counter()
+              time_limit=DEFAULTS["time_limit"], accel=DEFAULTS["accel"],
+              start=DEFAULTS["start"], initial=None, callback=None):
+        """Deform toward ``targets``; see :meth:`Deformer.solve` (``max_iter`` and
+        ``time_limit`` hold for each level). Returns a :class:`MultiresResult`."""
+        begin = time.perf_counter()
         targets = np.asarray(targets, dtype=float).reshape(-1, 3)
         cv = self.coarse.vertices
         warm = None if initial is None else (np.asarray(initial[0])[cv],
                                               np.asarray(initial[1])[cv])
-        coarse = self.coarse_deformer.solve(targets[self._coarse_slots], max_iter=max_iter,
-                                            tol=tol, initial=warm, callback=callback,
-                                            time_limit=time_limit)
-        stages = dict(self.stages, coarse_solve=time.perf_counter() - start)
+        solve_options = {"max_iter": max_iter, "tol": tol, "time_limit": time_limit,
+                         "accel": accel}
+        coarse = self.coarse_deformer.solve(targets[self._coarse_slots], initial=warm,
+                                            callback=callback, start=start, **solve_options)
+        stages = dict(self.stages, coarse_solve=time.perf_counter() - begin)
         mark = time.perf_counter()
         R = spread_rotors(self.solver, self._known_rotors(targets, coarse.rotors))
         stages["transfer"] = time.perf_counter() - mark
@@ -160,8 +174,19 @@ class MultiresDeformer:
         energy = self.fine.energy(P, R)
         if not (np.isfinite(P).all() and np.isfinite(energy["total"])):
             raise NumericalError("the full-resolution solve produced non-finite values")
-        return MultiresResult(P, R, coarse.log, coarse.converged, coarse.iterations,
-                              full_energy=energy, stages=stages, coarse=self.info)
+        log = [dict(row, step="coarse-" + row["step"]) for row in coarse.log]
+        if self.mode == "transfer":
+            return MultiresResult(P, R, log, coarse.converged, coarse.iterations,
+                                  full_energy=energy, stages=stages, coarse=self.info)
+        mark = time.perf_counter()
+        fine = self.fine.solve(targets, initial=(P, R), callback=callback, **solve_options)
+        stages["fine_iterations"] = time.perf_counter() - mark
+        offset, elapsed = len(log), mark - begin
+        log += [dict(row, iteration=row["iteration"] + offset, seconds=row["seconds"] + elapsed)
+                for row in fine.log]
+        return MultiresResult(fine.positions, fine.rotors, log, fine.converged,
+                              coarse.iterations + fine.iterations, coarse_log=False,
+                              full_energy=fine.energies(), stages=stages, coarse=self.info)
 
     def _known_rotors(self, targets, coarse_rotors):
         out = np.tile(IDENTITY, (self._known.size, 1))

@@ -4,10 +4,11 @@ A start is ``start(step, initial) -> State`` with ``step`` the solve's
 :class:`~srarap_cli.step.LocalGlobalStep` and ``initial`` the caller's ``(positions, rotors)``
 or None. :data:`STARTS` maps names to starts; :func:`register` adds one.
 """
-from .laplacian import laplacian
-from .warm import warm
+from .harmonic import harmonic_start
+from .laplacian import laplacian_start
+from .warm import warm_start
 
-STARTS = {"laplacian": laplacian, "warm": warm}
+STARTS = {"harmonic": harmonic_start, "laplacian": laplacian_start, "warm": warm_start}
 
 
 def register(name, start):

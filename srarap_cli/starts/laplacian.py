@@ -4,7 +4,7 @@ import numpy as np
 from ..quaternion import IDENTITY
 
 
-def laplacian(step, initial=None):
+def laplacian_start(step, initial=None):
     """Identity rotors everywhere, positions from one global step.
 
     Parameters

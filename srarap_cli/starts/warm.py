@@ -2,7 +2,7 @@
 import numpy as np
 
 
-def warm(step, initial):
+def warm_start(step, initial):
     """Start from ``initial = (positions (n, 3), rotors (n, 4))``, constrained vertices moved
     to their targets.
 
