@@ -7,6 +7,7 @@ from click.testing import CliRunner
 from helpers import ROOT, SHARED, random_rotation
 
 from srarap_cli.cli import main
+from srarap_cli.group_rotations import group_rotors
 from srarap_cli.handles import load_handles
 from srarap_cli.mesh_io import read_mesh
 from srarap_cli.multires import (
@@ -18,7 +19,6 @@ from srarap_cli.multires import (
 from srarap_cli.multires.cache import coarse_mesh
 from srarap_cli.multires.dirichlet import DirichletSolver
 from srarap_cli.multires.topology import topology_summary
-from srarap_cli.group_rotations import group_rotors
 from srarap_cli.multires.transfer import spread_rotors
 from srarap_cli.operators import cell_graph, mesh_area
 from srarap_cli.pipeline import problem

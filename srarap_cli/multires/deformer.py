@@ -7,11 +7,11 @@ import numpy as np
 
 from ..deformer import Deformer, DeformResult
 from ..errors import NumericalError
+from ..group_rotations import group_rotors
 from ..quaternion import IDENTITY
 from ..settings import DEFAULTS
 from .cache import coarse_mesh
 from .dirichlet import DirichletSolver
-from ..group_rotations import group_rotors
 from .transfer import orient_group_rotors, spread_rotors
 
 STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
