@@ -25,7 +25,8 @@ def test_bench_runs_and_its_summary_is_consistent_with_its_curves(tmp_path):
     with open(out / "curves.csv") as fh:
         rows = list(csv.DictReader(fh))
     names = [m["method"] for m in summary["methods"]]
-    assert names == ["sr-linear", "sr-linear-sym", "sr-relax", "arap", "libigl-arap"]
+    assert names == ["sr-linear", "sr-linear-sym", "sr-relax", "sr-linear-sym+anderson", "arap",
+                     "arap+anderson", "libigl-arap"]
     sr = [row for row in rows if row["method"].startswith("sr-")]
     best = min(float(row["total"]) for row in sr)
     for m in summary["methods"]:

@@ -29,7 +29,8 @@ OWN_DEFAULTS = {"tol": 1e-9, "max_iter": 100000}
               show_default=True, help="Seconds each method may run.")
 @click.option("-o", "--output", "out", type=click.Path(file_okay=False),
               help="Folder for curves.csv, summary.json and energy.png (created if missing).")
-@click_options(exclude=("method", "multires", "time_limit"), defaults=OWN_DEFAULTS)
+@click_options(exclude=("method", "multires", "multires_mode", "time_limit", "accel", "start"),
+               defaults=OWN_DEFAULTS)
 @guarded
 def bench(mesh, handles, methods, time_budget, out, overrides):
     """Run each method on MESH + HANDLES from the same start and compare them.
