@@ -1,0 +1,138 @@
+"""Iterations and seconds until converged: the default solver against the plain iteration.
+
+For each case: a tight solve (default settings, tol 1e-10) gives the reference shape and,
+with every other run, the best energy. Then the plain iteration from Laplacian editing (the
+paper's setting, `--accel none --start laplacian`) and the default (Anderson acceleration
+from the harmonic start, tol 1e-6) run `--repeat` times each; the table gives the medians of
+the seconds to come within 1% and 0.1% of the best energy, the iterations (deterministic),
+the ratios plain/default, and where the default run stopped: its iterations, seconds and
+distance to the tight shape relative to the bounding-box diagonal. `ms/it` is the median
+time per logged iteration; `ms/step` the default's time per local step (a rejected Anderson
+candidate costs one more local step than its iteration).
+
+Run: python benchmarks/convergence.py [--cases cylinder,max,spot,bar135,bar100k]
+     [--repeat 3] [--plain-budget 300] [--json out/convergence.json]
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+import numpy as np
+
+from srarap_cli import Deformer
+from srarap_cli.handles import load_handles
+from srarap_cli.mesh_io import read_mesh
+from srarap_cli.pipeline import problem
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")
+OUT = os.path.join(ROOT, "out")
+BARS = {"bar135": ("bar-6k.obj", ["--rings", "120", "--segments", "48"]),
+        "bar100k": ("bar-100k.obj", [])}
+CASES = {
+    "cylinder": (os.path.join(SHARED, "cylinder.off"), os.path.join(SHARED, "cylinder.sel")),
+    "max": (os.path.join(SHARED, "decimated-max.obj"),
+            os.path.join(HERE, "cases", "decimated-max.yaml")),
+    "spot": (os.path.join(ROOT, "sample_meshes", "spot.obj"),
+             os.path.join(ROOT, "configs", "spot-nod.yaml")),
+    "bar135": (os.path.join(OUT, "bar-6k.obj"), os.path.join(HERE, "cases", "bar-6k-twist135.yaml")),
+    "bar100k": (os.path.join(OUT, "bar-100k.obj"),
+                os.path.join(HERE, "cases", "bar-100k-twist.yaml")),
+}
+PLAIN = {"accel": "none", "start": "laplacian"}
+DEFAULT = {"accel": "anderson", "start": "harmonic"}
+
+
+def hits(log, best):
+    """(iterations, seconds) until within 1% and 0.1% of ``best`` (None: never)."""
+    out = []
+    for frac in (1e-2, 1e-3):
+        row = next((r for r in log if r["total"] <= best * (1 + frac)), None)
+        out.append((row["iteration"], row["seconds"]) if row else (None, None))
+    return out
+
+
+def median_or_none(values):
+    values = [v for v in values if v is not None]
+    return statistics.median(values) if values else None
+
+
+def run_case(name, args):
+    mesh_path, handles = CASES[name]
+    if name in BARS and not os.path.exists(mesh_path):
+        subprocess.run([sys.executable, os.path.join(HERE, "make_big_bar.py"), mesh_path,
+                        *BARS[name][1]], check=True)
+    mesh = read_mesh(mesh_path)
+    p = problem(mesh, load_handles(handles, mesh.vertices))
+    d = Deformer(p.V, p.F, p.ids, labels=p.labels)
+    diag = float(np.linalg.norm(np.ptp(p.V, axis=0)))
+    tight = d.solve(p.targets, tol=1e-10, max_iter=5000)
+    plain = [d.solve(p.targets, tol=1e-9, max_iter=20000, time_limit=args.plain_budget, **PLAIN)
+             for _ in range(args.repeat)]
+    fast = [d.solve(p.targets, tol=1e-6, **DEFAULT) for _ in range(args.repeat)]
+    best = min(row["total"] for r in [tight, *plain, *fast] for row in r.log)
+    row = {"case": name, "vertices": len(p.V), "best_energy": best}
+    for label, runs in (("plain", plain), ("default", fast)):
+        marks = [hits(r.log, best) for r in runs]
+        for k, key in enumerate(("1%", "0.1%")):
+            row[f"{label}_it@{key}"] = marks[0][k][0]
+            row[f"{label}_s@{key}"] = median_or_none([m[k][1] for m in marks])
+        row[f"{label}_ms/it"] = 1e3 * statistics.median(
+            r.log[-1]["seconds"] / max(r.iterations, 1) for r in runs)
+    steps = fast[0].iterations + sum(x["step"] == "fallback" for x in fast[0].log)
+    row["default_ms/step"] = 1e3 * statistics.median(r.log[-1]["seconds"] for r in fast) / steps
+    row["default_fallbacks"] = sum(x["step"] == "fallback" for x in fast[0].log)
+    row["default_stop_it"] = fast[0].iterations
+    row["default_stop_s"] = statistics.median(r.log[-1]["seconds"] for r in fast)
+    row["default_converged"] = fast[0].converged
+    row["default_dist/diag"] = float(np.linalg.norm(fast[0].positions - tight.positions,
+                                                    axis=1).max() / diag)
+    for key in ("1%", "0.1%"):
+        a, b = row[f"plain_it@{key}"], row[f"default_it@{key}"]
+        row[f"ratio_it@{key}"] = a / b if a and b else None
+        a, b = row[f"plain_s@{key}"], row[f"default_s@{key}"]
+        row[f"ratio_s@{key}"] = a / b if a and b else None
+    return row
+
+
+def fmt(value, spec):
+    return "-" if value is None else format(value, spec)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cases", default=",".join(CASES))
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--plain-budget", type=float, default=300.0,
+                    help="seconds the plain iteration may run per repeat")
+    ap.add_argument("--json")
+    args = ap.parse_args()
+    rows = []
+    print("| case | n | plain it@1% | s@1% | it@0.1% | s@0.1% | default it@1% | s@1% | "
+          "it@0.1% | s@0.1% | ratio it / s @0.1% | default stop: it, s, dist/diag | "
+          "ms/it plain, default; ms/step |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for name in args.cases.split(","):
+        r = run_case(name, args)
+        rows.append(r)
+        print(f"| {name} | {r['vertices']} | {fmt(r['plain_it@1%'], 'd')} | "
+              f"{fmt(r['plain_s@1%'], '.2f')} | {fmt(r['plain_it@0.1%'], 'd')} | "
+              f"{fmt(r['plain_s@0.1%'], '.2f')} | {fmt(r['default_it@1%'], 'd')} | "
+              f"{fmt(r['default_s@1%'], '.2f')} | {fmt(r['default_it@0.1%'], 'd')} | "
+              f"{fmt(r['default_s@0.1%'], '.2f')} | {fmt(r['ratio_it@0.1%'], '.1f')} / "
+              f"{fmt(r['ratio_s@0.1%'], '.1f')} | {r['default_stop_it']}, "
+              f"{r['default_stop_s']:.2f}, {r['default_dist/diag']:.1e} | "
+              f"{r['plain_ms/it']:.1f}, {r['default_ms/it']:.1f}; {r['default_ms/step']:.1f} |",
+              flush=True)
+    if args.json:
+        os.makedirs(os.path.dirname(os.path.abspath(args.json)), exist_ok=True)
+        with open(args.json, "w") as fh:
+            json.dump(rows, fh, indent=2)
+
+
+if __name__ == "__main__":
+    main()
