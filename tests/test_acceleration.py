@@ -123,3 +123,27 @@ def test_coarse_to_fine_reaches_the_direct_solve():
     assert np.abs(refined.positions - direct.positions).max() < 1e-3 * diagonal(V)
     assert approx.energy > refined.energy * (1 + 1e-3)
     assert {"coarse-start", "start"} <= {row["step"] for row in refined.log}
+
+
+def test_cli_options_choose_the_driver_and_an_unconverged_run_says_what_to_try(tmp_path):
+    import csv
+
+    from click.testing import CliRunner
+    from helpers import ROOT
+
+    from srarap_cli.cli import main
+    bar_obj = f"{ROOT}/sample_meshes/bar.obj"
+    twist_yaml = f"{ROOT}/configs/bar-twist.yaml"
+    log = tmp_path / "log.csv"
+    r = CliRunner().invoke(main, ["deform", bar_obj, twist_yaml, "-o", str(tmp_path / "o.obj"),
+                                  "--log", str(log), "--accel", "none", "--start", "laplacian",
+                                  "--max-iter", "3"])
+    assert r.exit_code == 3
+    assert "try: raise --max-iter (was 3), use --accel anderson, --start harmonic" in r.stderr
+    with open(log) as fh:
+        assert {row["step"] for row in csv.DictReader(fh)} == {"start", "plain"}
+    r = CliRunner().invoke(main, ["deform", bar_obj, twist_yaml, "-o", str(tmp_path / "o.obj"),
+                                  "--log", str(log)])
+    assert r.exit_code == 0, r.output
+    with open(log) as fh:
+        assert "anderson" in {row["step"] for row in csv.DictReader(fh)}

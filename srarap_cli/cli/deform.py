@@ -74,10 +74,30 @@ def _summary(result, opts, out):
     last = result.log[-1]
     state = (f"converged in {result.iterations} iterations" if result.converged else
              f"NOT converged after {result.iterations} iterations "
-             f"(relative change {last['rel_change']:.3g} > tol {opts['tol']:g})")
+             f"({_why(last, opts)}; {_advice(result, opts)})")
     e = result.energies()
     where = f"coarse energy {last['total']:.6g}; full " if result.coarse_log else ""
     return (f"srarap deform: {state}; {where}energy {e['total']:.6g} (membrane "
             f"{e['membrane']:.6g}, bending {e['bending']:.6g}); {result.seconds:.2f} s; "
             f"wrote {out}")
 
+
+
+def _why(last, opts):
+    if last["rel_change"] > opts["tol"]:
+        return f"relative change {last['rel_change']:.3g} > tol {opts['tol']:g}"
+    return (f"relative change {last['rel_change']:.3g} but the last step still moved a vertex "
+            f"by {last['max_move']:.3g}")
+
+
+def _advice(result, opts):
+    """What to try after a run that stopped unconverged, from how it stopped."""
+    if opts["time_limit"] is not None and result.seconds >= opts["time_limit"]:
+        return f"stopped by --time-limit {opts['time_limit']:g}: allow more time"
+    tips = [f"raise --max-iter (was {opts['max_iter']})"]
+    if opts["accel"] == "none":
+        tips.append("use --accel anderson")
+    if opts["start"] == "laplacian":
+        tips.append("--start harmonic")
+    tips.append(f"or loosen --tol (the last change was {result.log[-1]['rel_change']:.2g})")
+    return "try: " + ", ".join(tips)
