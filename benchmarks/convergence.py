@@ -10,7 +10,7 @@ distance to the tight shape relative to the bounding-box diagonal. `ms/it` is th
 time per logged iteration; `ms/step` the default's time per local step (a rejected Anderson
 candidate costs one more local step than its iteration).
 
-Run: python benchmarks/convergence.py [--cases cylinder,max,spot,bar135,bar100k]
+Run: python benchmarks/convergence.py [--cases cylinder,max,spot,bar100k,bar135]
      [--repeat 3] [--plain-budget 300] [--json out/convergence.json]
 """
 import argparse
@@ -21,28 +21,17 @@ import subprocess
 import sys
 
 import numpy as np
+from run_bench import BIG_BAR, CASES, HERE, OUT
 
 from srarap_cli import Deformer
 from srarap_cli.handles import load_handles
 from srarap_cli.mesh_io import read_mesh
 from srarap_cli.pipeline import problem
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")
-OUT = os.path.join(ROOT, "out")
-BARS = {"bar135": ("bar-6k.obj", ["--rings", "120", "--segments", "48"]),
-        "bar100k": ("bar-100k.obj", [])}
-CASES = {
-    "cylinder": (os.path.join(SHARED, "cylinder.off"), os.path.join(SHARED, "cylinder.sel")),
-    "max": (os.path.join(SHARED, "decimated-max.obj"),
-            os.path.join(HERE, "cases", "decimated-max.yaml")),
-    "spot": (os.path.join(ROOT, "sample_meshes", "spot.obj"),
-             os.path.join(ROOT, "configs", "spot-nod.yaml")),
-    "bar135": (os.path.join(OUT, "bar-6k.obj"), os.path.join(HERE, "cases", "bar-6k-twist135.yaml")),
-    "bar100k": (os.path.join(OUT, "bar-100k.obj"),
-                os.path.join(HERE, "cases", "bar-100k-twist.yaml")),
-}
+BARS = {os.path.basename(BIG_BAR): [],
+        "bar-6k.obj": ["--rings", "120", "--segments", "48"]}
+CASES = {**CASES, "bar135": (os.path.join(OUT, "bar-6k.obj"),
+                             os.path.join(HERE, "cases", "bar-6k-twist135.yaml"))}
 PLAIN = {"accel": "none", "start": "laplacian"}
 DEFAULT = {"accel": "anderson", "start": "harmonic"}
 
@@ -63,9 +52,10 @@ def median_or_none(values):
 
 def run_case(name, args):
     mesh_path, handles = CASES[name]
-    if name in BARS and not os.path.exists(mesh_path):
-        subprocess.run([sys.executable, os.path.join(HERE, "make_big_bar.py"), mesh_path,
-                        *BARS[name][1]], check=True)
+    bar = BARS.get(os.path.basename(mesh_path))
+    if bar is not None and not os.path.exists(mesh_path):
+        subprocess.run([sys.executable, os.path.join(HERE, "make_big_bar.py"), mesh_path, *bar],
+                       check=True)
     mesh = read_mesh(mesh_path)
     p = problem(mesh, load_handles(handles, mesh.vertices))
     d = Deformer(p.V, p.F, p.ids, labels=p.labels)

@@ -15,7 +15,8 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")
-BIG_BAR = os.path.join(ROOT, "out", "bar-100k.obj")
+OUT = os.path.join(ROOT, "out")
+BIG_BAR = os.path.join(OUT, "bar-100k.obj")
 CASES = {
     "cylinder": (os.path.join(SHARED, "cylinder.off"), os.path.join(SHARED, "cylinder.sel")),
     "max": (os.path.join(SHARED, "decimated-max.obj"),
