@@ -97,6 +97,7 @@ class Deformer:
     ----------
     fixed : (j,) int array, every vertex whose position is held: constrained and auto_fixed
     constrained_slots : (k,) int array, where each constrained vertex sits in ``fixed``
+    diagonal : float, the rest mesh's bounding-box diagonal (scale of the stopping test)
     auto_fixed : (j,) int array
         Vertices kept at rest because nothing could move them: unreferenced vertices and
         every connected part that holds no constrained vertex.
@@ -143,6 +144,7 @@ class Deformer:
                        if labels is None else np.asarray(labels, dtype=np.int64).ravel())
         self.edges = RestEdges(self.graph, self.V)
         self.energy_floor = 1e-14 * max(float(self.graph.c @ self.edges.q_sq), 1e-300)
+        self.diagonal = float(np.linalg.norm(np.ptp(self.V, axis=0)))
         self._bending_alpha = self.alpha if METHODS[method].bending else 0.0
         self._poisson = self._local_step = None
         if prepare:
@@ -224,7 +226,7 @@ class Deformer:
         self.prepare()
         monitor = Monitor(max_iter=max_iter, tol=tol, time_limit=time_limit,
                           callback=callback, energy_floor=self.energy_floor,
-                          scale=float(np.linalg.norm(np.ptp(self.V, axis=0))))
+                          scale=self.diagonal)
         step = self.step_for(targets, tol)
         first = STARTS["warm" if initial is not None else start](step, initial)
         state = DRIVERS[driver or ACCEL_DRIVERS[accel]](step, first, monitor)
