@@ -28,7 +28,7 @@ from srarap_cli.pipeline import problem
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from run_bench import BIG_BAR, CASES
+from run_bench import BIG_BAR, CASES  # noqa: E402  (after the sys.path entry)
 
 
 def interleaved(p, rounds, block, tol):

@@ -5,6 +5,10 @@ multires result relative to the direct result's (with the rotors it returns, and
 refitted to its positions by one full-resolution local step), and the max and mean vertex
 distance to the direct result relative to the bounding-box diagonal.
 
+``--mode refine`` measures the default coarse-to-fine solve instead of the transfer alone;
+``--meshlab`` swaps in MeshLab's simplification (pymeshlab, GPL, installed separately) so the
+two simplifiers can be compared in one run.
+
 Run: python benchmarks/make_big_spot.py out/spot-46k.obj --levels 1
      python benchmarks/multires_quality.py out/spot-46k.obj configs/spot-nod.yaml \
          --sizes 1000 2500 5000 10000 --json out/multires-quality.json
@@ -21,6 +25,23 @@ from srarap_cli.handles import load_handles
 from srarap_cli.mesh_io import read_mesh
 from srarap_cli.pipeline import build_deformer, problem
 from srarap_cli.settings import resolve
+
+
+def use_meshlab():
+    """Route the multires simplification through MeshLab's collapse (benchmark peer)."""
+    import sys
+
+    import srarap_cli.multires.cache as cache
+    from srarap_cli.multires.simplify import CoarseMesh
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from simplify_quality import meshlab_subset
+
+    def simplify(V, F, size, groups=()):
+        ids, G = meshlab_subset(V, F, size)
+        if any(not np.isin(g, ids).any() for g in groups):
+            raise RuntimeError("MeshLab dropped a handle group; try another size")
+        return CoarseMesh(ids, G, [])
+    cache.simplify_to_subset = simplify
 
 
 def refit_energy(direct, P, R):
@@ -58,13 +79,19 @@ def main():
     ap.add_argument("--tol", type=float, default=1e-6)
     ap.add_argument("--max-iter", type=int, default=5000)
     ap.add_argument("--json")
+    ap.add_argument("--mode", choices=["transfer", "refine"], default="transfer",
+                    help="multires mode measured (transfer: the paper's approximation)")
+    ap.add_argument("--meshlab", action="store_true",
+                    help="simplify with MeshLab (the GPL peer; needs pymeshlab installed)")
     ap.add_argument("--reference", help="npz keeping the direct solve between runs (it takes "
                     "long); reused when it exists")
     args = ap.parse_args()
     mesh = read_mesh(args.mesh)
     c = load_handles(args.handles, mesh.vertices)
     p = problem(mesh, c)
-    opts = resolve(c.solver, {})
+    opts = dict(resolve(c.solver, {}), multires_mode=args.mode)
+    if args.meshlab:
+        use_meshlab()
     direct, ref, direct_s = reference(p, opts, args)
     diag = float(np.linalg.norm(np.ptp(p.V, axis=0)))
     e_ref = ref.energy

@@ -6,9 +6,11 @@ The solve is composed of parts that each live in their own module: a start
 when to stop. This class holds what they share: weights, rest edges, the factored Poisson
 matrix and the local step.
 """
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.sparse import csgraph
 
 from .drivers import DRIVERS, Monitor
@@ -43,20 +45,20 @@ class DeformResult:
     coarse_log = False
     positions: np.ndarray
     rotors: np.ndarray
-    log: list = field(default_factory=list)
+    log: list[dict] = field(default_factory=list)
     converged: bool = False
     iterations: int = 0
 
-    def energies(self):
+    def energies(self) -> dict[str, float]:
         """``membrane``, ``bending`` and ``total`` energy of the returned shape."""
         return {k: self.log[-1][k] for k in ("membrane", "bending", "total")}
 
     @property
-    def energy(self):
+    def energy(self) -> float:
         return self.energies()["total"]
 
     @property
-    def seconds(self):
+    def seconds(self) -> float:
         """Wall time of the solve."""
         return self.log[-1]["seconds"]
 
@@ -113,10 +115,11 @@ class Deformer:
     (True, True)
     """
 
-    def __init__(self, V, F, constrained, *, alpha=DEFAULTS["alpha"],
-                 feedback=DEFAULTS["feedback"], weights=DEFAULTS["weights"], area=None,
-                 method=DEFAULTS["method"], sweeps=DEFAULTS["sweeps"], labels=None,
-                 prepare=True):
+    def __init__(self, V: ArrayLike, F: ArrayLike, constrained: ArrayLike, *,
+                 alpha: float = DEFAULTS["alpha"], feedback: float = DEFAULTS["feedback"],
+                 weights: str = DEFAULTS["weights"], area: float | None = None,
+                 method: str = DEFAULTS["method"], sweeps: int = DEFAULTS["sweeps"],
+                 labels: ArrayLike | None = None, prepare: bool = True) -> None:
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
         if not alpha > 0:
@@ -199,9 +202,12 @@ class Deformer:
         """The :class:`~srarap_cli.step.LocalGlobalStep` of one set of targets."""
         return LocalGlobalStep(self, targets, tol)
 
-    def solve(self, targets, *, max_iter=DEFAULTS["max_iter"], tol=DEFAULTS["tol"],
-              time_limit=DEFAULTS["time_limit"], accel=DEFAULTS["accel"],
-              start=DEFAULTS["start"], initial=None, callback=None, driver=None):
+    def solve(self, targets: ArrayLike, *, max_iter: int = DEFAULTS["max_iter"],
+              tol: float = DEFAULTS["tol"], time_limit: float | None = DEFAULTS["time_limit"],
+              accel: str = DEFAULTS["accel"], start: str = DEFAULTS["start"],
+              initial: tuple[np.ndarray, np.ndarray] | None = None,
+              callback: Callable[[dict], None] | None = None,
+              driver: Callable | None = None) -> DeformResult:
         """Deform toward ``targets`` for the constrained vertices.
 
         Parameters

@@ -1,5 +1,11 @@
 """Choose, build and run a solver from settings: direct or multiresolution."""
-from .deformer import Deformer
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .deformer import Deformer, DeformResult
 from .multires import MultiresDeformer, coarse_size
 from .settings import DEFAULTS, check_keywords, stage_options
 
@@ -31,8 +37,10 @@ def make_deformer(V, F, constrained, labels=None, *, area=None, cache=None, **op
                             **setup)
 
 
-def deform(V, F, constrained, targets, *, initial=None, callback=None, cache=None,
-           **settings):
+def deform(V: ArrayLike, F: ArrayLike, constrained: ArrayLike, targets: ArrayLike, *,
+           initial: tuple[np.ndarray, np.ndarray] | None = None,
+           callback: Callable[[dict], None] | None = None, cache: str | None = None,
+           **settings: Any) -> DeformResult:
     """One-shot deformation: build the solver and solve once.
 
     Parameters

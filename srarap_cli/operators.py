@@ -5,7 +5,8 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
-WEIGHT_KINDS = ("cotan", "cotan-clamped", "uniform")
+from .settings import WEIGHT_KINDS
+
 # Half-cotangents are bounded: an angle under ~0.06 degrees (a needle) would otherwise give
 # a weight that swamps its neighbours and the conditioning of every solve.
 MAX_HALF_COT = 500.0

@@ -1,9 +1,14 @@
 """From a mesh and its constraints to the deformed mesh: the path every command shares."""
+from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
+from .deformer import DeformResult
+from .handles import Constraints
 from .mesh_checks import mesh_warnings, solvable_faces
+from .mesh_io import Mesh
 from .oneshot import make_deformer
 from .operators import mesh_area
 from .quaternion import IDENTITY
@@ -80,7 +85,9 @@ def scatter(mesh, p, positions, constraints, constraint_targets=None):
     return out
 
 
-def deform_mesh(mesh, constraints, callback=None, cache=None, **overrides):
+def deform_mesh(mesh: Mesh, constraints: Constraints,
+                callback: Callable[[dict], None] | None = None, cache: str | None = None,
+                **overrides: Any) -> tuple[Mesh, DeformResult, list[str]]:
     """Deform a :class:`~srarap_cli.mesh_io.Mesh` by its :class:`~srarap_cli.handles.Constraints`.
 
     Parameters

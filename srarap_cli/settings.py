@@ -15,7 +15,9 @@ import click
 
 from .local_step import METHODS
 from .multires.size import AUTO_SIZE, AUTO_THRESHOLD, parse_size
-from .operators import WEIGHT_KINDS
+
+#: Edge weights of the Laplacian and the bending term (see :func:`operators.cell_graph`).
+WEIGHT_KINDS = ("cotan", "cotan-clamped", "uniform")
 
 
 @dataclass(frozen=True)

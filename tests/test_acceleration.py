@@ -51,6 +51,7 @@ def test_accepted_accelerated_iterates_never_raise_the_energy(long_tube, method)
             assert row["total"] <= before["total"] + slack, row
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["sr-linear-sym", "sr-linear", "arap"])
 def test_accelerated_and_plain_iterations_reach_the_same_shape(method):
     """Both reach the plain map's fixed point: the plain iteration run 4000 steps without a

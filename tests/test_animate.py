@@ -57,7 +57,7 @@ def test_a_240_degree_twist_is_temporally_coherent(feedback):
         assert jump <= 1.5 * handle + 1e-12
 
 
-@pytest.mark.parametrize("rings, multires", [(6, "off"), (30, 60)])
+@pytest.mark.parametrize("rings, multires", [(6, "off"), pytest.param(30, 60, marks=pytest.mark.slow)])
 def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames(rings, multires):
     mesh = tube_mesh(rings=rings, segments=6)
     keys = [{"frame": 0}, {"frame": 3, "rotate": {"axis": [1, 1, 0], "angle": 90},
@@ -77,6 +77,7 @@ def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames(rings, multir
         assert np.abs(P - expected).max() < 1e-8
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("extra", [[], ["--multires", "150"]])
 def test_sequence_is_deterministic_and_resume_after_a_kill_gives_the_same_files(tmp_path, extra):
     ref, cut = tmp_path / "ref", tmp_path / "cut"

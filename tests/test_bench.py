@@ -3,6 +3,7 @@ import csv
 import json
 
 import numpy as np
+import pytest
 import yaml
 from click.testing import CliRunner
 from helpers import tube_mesh
@@ -11,6 +12,7 @@ from srarap_cli.cli import main
 from srarap_cli.mesh_io import write_mesh
 
 
+@pytest.mark.slow
 def test_bench_runs_and_its_summary_is_consistent_with_its_curves(tmp_path):
     write_mesh(str(tmp_path / "t.obj"), tube_mesh(rings=5, segments=6))
     (tmp_path / "h.yaml").write_text(yaml.safe_dump({"groups": {

@@ -180,3 +180,34 @@ def test_json_handles_and_sel_file_through_the_command(small, tmp_path):
     P = read_mesh(str(out)).vertices
     assert np.array_equal(P[status == 0], V[status == 0])
     assert np.allclose(P[status == 2], V[status == 2] + [0.5, 0, 0], atol=1e-15)
+
+
+HEAVY = ("numpy", "scipy", "igl", "meshio", "matplotlib", "distributed", "yaml",
+         "srarap_cli.multires.deformer", "srarap_cli.multires.collapse")
+
+
+@pytest.mark.parametrize("code", ["import srarap_cli",
+                                  "from srarap_cli.cli import main\n"
+                                  "main(['--help'], standalone_mode=False)"])
+def test_the_package_and_the_top_level_help_load_no_numerical_stack(code):
+    probe = code + "\nimport sys\nprint(sorted(m for m in sys.modules if m.split('.')[0] in " \
+        f"{HEAVY!r} or m in {HEAVY!r}))"
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.strip().splitlines()[-1] == "[]"
+
+
+def test_the_top_level_help_lists_each_commands_own_summary():
+    from srarap_cli.cli import COMMANDS
+    for name, (_, _, summary) in COMMANDS.items():
+        assert main.get_command(None, name).get_short_help_str(limit=300) == summary
+    listed = CliRunner().invoke(main, ["--help"]).output
+    assert all(name in listed for name in COMMANDS)
+
+
+def test_the_public_api_is_reachable_from_the_package():
+    import srarap_cli
+    for name in srarap_cli.__all__:
+        assert getattr(srarap_cli, name) is not None
+    with pytest.raises(AttributeError):
+        srarap_cli.no_such_name  # noqa: B018

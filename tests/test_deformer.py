@@ -184,6 +184,7 @@ def test_bad_parameters_are_rejected(bar):
         Deformer(V, F, ids, weights="mean-value")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("weights", ["cotan", "uniform"])
 def test_other_weight_kinds_reach_rigid_motion(bar, weights):
     V, F, ids = bar

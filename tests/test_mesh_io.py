@@ -5,7 +5,7 @@ import os
 import meshio
 import numpy as np
 import pytest
-from helpers import ROOT, SHARED, tube_mesh
+from helpers import ROOT, SHARED, needs_shared, tube_mesh
 
 from srarap_cli.errors import InputError
 from srarap_cli.mesh_io import format_mesh, read_mesh, write_mesh
@@ -80,6 +80,7 @@ def test_normals_follow_the_deformation():
     assert np.allclose(np.linalg.norm(moved.normals, axis=1), 1)
 
 
+@pytest.mark.slow
 def test_output_bytes_are_deterministic(tmp_path):
     mesh = read_mesh(os.path.join(ROOT, "sample_meshes", "spot.obj"))
     for suffix in (".obj", ".off", ".ply"):
@@ -87,6 +88,7 @@ def test_output_bytes_are_deterministic(tmp_path):
             os.path.join(ROOT, "sample_meshes", "spot.obj")), suffix)[0]
 
 
+@needs_shared
 def test_every_shared_mesh_reads_with_its_vertex_count():
     assert os.path.isdir(SHARED), "the tests expect ../shared/meshes beside the repository"
     counts = {"cylinder.off": 4802, "decimated-max.obj": 5272, "spot.obj": 11533,

@@ -23,6 +23,7 @@ def bent():
     return T
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", list(METHODS))
 def test_every_method_reproduces_a_rigid_motion_exactly(method):
     Rm = to_matrix(from_axis_angle([1, -2, 0.5], 150))

@@ -4,7 +4,7 @@ import os
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from helpers import ROOT, SHARED, random_rotation
+from helpers import ROOT, SHARED, needs_shared, random_rotation, torus, tube
 
 from srarap_cli.cli import main
 from srarap_cli.group_rotations import group_rotors
@@ -47,18 +47,35 @@ def test_coarse_vertices_are_fine_vertices_and_span_the_same_surface(spot):
     assert c.warnings == []
 
 
-@pytest.mark.parametrize("name, genus_euler, loops", [("torus.obj", 0, 0),
-                                                     ("hand_lowres.obj", 1, 1)])
-def test_simplification_keeps_manifoldness_genus_and_boundaries(name, genus_euler, loops):
-    mesh = read_mesh(os.path.join(SHARED, name))
-    F = mesh.triangles()[0]
-    c = simplify_to_subset(mesh.vertices, F, len(mesh.vertices) // 8)
-    fine, coarse = topology_summary(F, len(mesh.vertices)), topology_summary(c.faces,
-                                                                             len(c.vertices))
+def open_tube():
+    V, F = tube(rings=30, segments=16)
+    caps = np.flatnonzero((V[:, 2] < 1e-9) | (V[:, 2] > 6 - 1e-9))
+    # drop the cap triangles (those touching a cap centre): two boundary loops remain
+    centres = caps[np.hypot(V[caps, 0], V[caps, 1]) < 1e-9]
+    return V, F[~np.isin(F, centres).any(axis=1)]
+
+
+def check_topology_kept(V, F, genus_euler, loops):
+    c = simplify_to_subset(V, F, len(np.unique(F)) // 8)
+    fine, coarse = topology_summary(F, len(V)), topology_summary(c.faces, len(c.vertices))
     assert fine["euler"] == coarse["euler"] == genus_euler
     assert fine["boundary_loops"] == coarse["boundary_loops"] == loops
     assert coarse["edge_manifold"] and coarse["components"] == 1
-    assert len(c.vertices) < len(mesh.vertices) // 4
+    assert len(c.vertices) < len(np.unique(F)) // 4
+    assert c.warnings == []
+
+
+@pytest.mark.parametrize("make, genus_euler, loops", [(torus, 0, 0), (open_tube, 0, 2)])
+def test_simplification_keeps_manifoldness_genus_and_boundaries(make, genus_euler, loops):
+    check_topology_kept(*make(), genus_euler, loops)
+
+
+@needs_shared
+@pytest.mark.parametrize("name, genus_euler, loops", [("torus.obj", 0, 0),
+                                                     ("hand_lowres.obj", 1, 1)])
+def test_simplification_keeps_the_topology_of_real_meshes(name, genus_euler, loops):
+    mesh = read_mesh(os.path.join(SHARED, name))
+    check_topology_kept(mesh.vertices, mesh.triangles()[0], genus_euler, loops)
 
 
 def test_every_handle_group_keeps_a_coarse_vertex(spot):
@@ -108,6 +125,7 @@ def test_group_rotors_recover_each_groups_rotation_and_flag_collinear_groups():
     assert ok.tolist() == [True] * 8 + [False] * 4
 
 
+@pytest.mark.slow
 def test_rigid_motion_of_all_handles_is_reproduced_exactly_through_multires(spot):
     V = spot[0]
     c = load_handles(NOD, V)
@@ -117,7 +135,7 @@ def test_rigid_motion_of_all_handles_is_reproduced_exactly_through_multires(spot
     d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=250)
     assert d.n_groups == 2 and all(np.isin(g, d.coarse.vertices).any()
                                    for g in (c.groups["hooves"], c.groups["head"]))
-    r = d.solve(p.V[p.ids] @ to_matrix(q[None])[0].T + t, max_iter=3000, tol=1e-13)
+    r = d.solve(p.V[p.ids] @ to_matrix(q[None])[0].T + t, max_iter=200)
     expect = V @ to_matrix(q[None])[0].T + t
     diag = np.linalg.norm(np.ptp(V, axis=0))
     assert np.abs(r.positions - expect).max() < 1e-8 * diag
@@ -212,18 +230,6 @@ def test_region_of_interest_moves_every_handle_vertex_and_nothing_outside(tmp_pa
     assert np.array_equal(moved[outside], rest[outside])
     assert np.abs(moved[c.ids] - c.targets).max() < 1e-12
     assert np.abs(moved[c.region] - rest[c.region]).max() > 0.05
-
-
-def test_fine_ids_follow_positions_when_a_collapse_moved_the_survivor():
-    """A half-edge collapse may leave vertex a at vertex b's position; the position names the
-    fine vertex, and coincident fine vertices are handed out once each."""
-    from srarap_cli.multires.simplify import _fine_ids
-    V = np.array([[0., 0, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0], [5, 5, 5]])
-    U = np.array([[0., 0, 0], [1, 0, 0], [1, 0, 0], [5, 5, 5]])
-    carried = np.array([0.0, 3.0, 1.0, 4.0])  # the second survivor carries 3 but sits on 1/2
-    ids = _fine_ids(V, U, carried)
-    assert np.array_equal(V[ids], U) and len(set(ids.tolist())) == 4
-    assert ids[0] == 0 and ids[3] == 4 and ids[2] == 1 and ids[1] == 2
 
 
 @pytest.mark.parametrize("method", ["sr-linear", "sr-linear-sym", "sr-relax", "arap"])

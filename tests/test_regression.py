@@ -3,6 +3,7 @@ import csv
 import os
 
 import numpy as np
+import pytest
 from click.testing import CliRunner
 from helpers import ROOT
 
@@ -45,6 +46,7 @@ def test_twist_golden_keeps_the_bars_rotational_symmetry():
     assert np.abs(P[perm] - P @ turn.T).max() < 10 * input_asymmetry
 
 
+@pytest.mark.slow
 def test_regression_suite_matches_its_goldens(tmp_path):
     r = CliRunner().invoke(main, ["batch", os.path.join(HERE, "manifest.yaml"), "-o",
                                   str(tmp_path), "--workers", "2"])

@@ -130,6 +130,7 @@ def test_a_mesh_that_would_not_fit_is_refused_early(tmp_path, tube):
     assert not (tmp_path / "o.obj").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_a_killed_run_leaves_the_old_output_whole(tmp_path, sig, code):
     """Kill a long deform mid-iteration: exit code says so, the old output is untouched and

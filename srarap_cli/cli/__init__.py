@@ -1,25 +1,49 @@
-"""The ``srarap`` command group; each subcommand lives in its own module."""
+"""The ``srarap`` command group; each subcommand lives in its own module.
+
+Subcommand modules are imported only when their command runs, so that ``srarap --help`` does
+not load the numerical stack (about a second).
+"""
+import importlib
+
 import click
 
-from .animate import animate
-from .batch import batch
-from .bench import bench
-from .compare import compare
-from .deform import deform
-from .render import plot, render
+#: name -> (module, function, one-line help shown by ``srarap --help``)
+COMMANDS = {
+    "deform": ("deform", "deform", "Deform MESH as rigidly as possible with smooth rotations."),
+    "bench": ("bench", "bench", "Run each method on MESH + HANDLES from the same start and "
+                                "compare them."),
+    "animate": ("animate", "animate", "Deform MESH through the keyframes of HANDLES, writing "
+                                      "one mesh per frame."),
+    "compare": ("compare", "compare", "Compare meshes A and B: per vertex when they have the "
+                                      "same vertices and faces, else by the symmetric "
+                                      "Hausdorff distance of their surfaces."),
+    "batch": ("batch", "batch", "Run every job of MANIFEST (YAML/JSON); a failing job never "
+                                "stops the others."),
+    "render": ("render", "render", "Render MESH to a PNG, headless."),
+    "plot": ("render", "plot", "Plot total energy against iteration and time for one or more "
+                               "deform logs (CSV/JSONL)."),
+}
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class LazyGroup(click.Group):
+    """A group whose commands are imported on first use."""
+
+    def list_commands(self, ctx):
+        return list(COMMANDS)
+
+    def get_command(self, ctx, name):
+        if name not in COMMANDS:
+            return None
+        module, attr, _ = COMMANDS[name]
+        return getattr(importlib.import_module(f".{module}", __name__), attr)
+
+    def format_commands(self, ctx, formatter):
+        with formatter.section("Commands"):
+            formatter.write_dl([(name, short) for name, (_, _, short) in COMMANDS.items()])
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--debug", is_flag=True, help="Show tracebacks of failures.")
 @click.version_option(package_name="srarap-cli", prog_name="srarap")
 def main(debug):
     """Deform triangle meshes as rigidly as possible with smooth rotations (SR-ARAP)."""
-
-
-main.add_command(deform)
-main.add_command(bench)
-main.add_command(animate)
-main.add_command(compare)
-main.add_command(batch)
-main.add_command(render)
-main.add_command(plot)

@@ -59,7 +59,8 @@ class Constraints:
         return out
 
 
-def load_handles(path, V, fps=None):
+def load_handles(path: str | os.PathLike, V: np.ndarray,
+                 fps: float | None = None) -> "Constraints":
     """Read and validate a handle file against rest positions ``V`` (n, 3).
 
     Parameters

@@ -5,14 +5,14 @@ The paper's units have their own modules: section 6.2 (rotors of constrained ver
 their own 4x4 systems) in ``constrained_rotors``, section 6.3 (feedback) in ``feedback``, the
 cells' 4x4 matrices (section 8) in ``membrane``, the one sparse solve in ``rotor_system``.
 """
-from typing import ClassVar, Protocol
+from __future__ import annotations
 
-import numpy as np
+import importlib
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, ClassVar, Protocol
 
-from .arap import ArapRotorStep
-from .linear import LinearRotorStep
-from .linear_sym import SymmetricRotorStep
-from .relax import RelaxRotorStep
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class LocalStep(Protocol):
@@ -34,9 +34,30 @@ class LocalStep(Protocol):
         (n,) and the previous rotors ``R_prev`` (n, 4)."""
 
 
-METHODS: dict[str, type[LocalStep]] = {
-    "sr-linear": LinearRotorStep,
-    "sr-linear-sym": SymmetricRotorStep,
-    "sr-relax": RelaxRotorStep,
-    "arap": ArapRotorStep,
-}
+class _Methods(Mapping):
+    """Method name -> local step class, each module imported on first use (the names are
+    needed by the command line's options long before any solve)."""
+
+    def __init__(self, where):
+        self._where = where
+
+    def __getitem__(self, name):
+        module, cls = self._where[name]
+        return getattr(importlib.import_module(module, __name__), cls)
+
+    def __contains__(self, name):
+        return name in self._where
+
+    def __iter__(self):
+        return iter(self._where)
+
+    def __len__(self):
+        return len(self._where)
+
+
+METHODS: Mapping[str, type[LocalStep]] = _Methods({
+    "sr-linear": (".linear", "LinearRotorStep"),
+    "sr-linear-sym": (".linear_sym", "SymmetricRotorStep"),
+    "sr-relax": (".relax", "RelaxRotorStep"),
+    "arap": (".arap", "ArapRotorStep"),
+})

@@ -10,7 +10,6 @@ import struct
 import warnings
 from contextlib import redirect_stderr, redirect_stdout
 
-import meshio
 import numpy as np
 
 from ..errors import InputError, OutputError
@@ -25,9 +24,6 @@ from .ply import format_ply, mesh_from_meshio, per_vertex
 READ_FORMATS = (".obj", ".off", ".ply", ".stl")
 WRITE_FORMATS = (".obj", ".off", ".ply")
 
-_MESHIO_FAILURES = (SystemExit, meshio.ReadError, ValueError, IndexError, KeyError, EOFError,
-                    TypeError, struct.error)
-
 __all__ = ["READ_FORMATS", "WRITE_FORMATS", "Mesh", "atomic_write", "read_mesh", "write_mesh"]
 
 
@@ -35,7 +31,7 @@ def _suffix(path):
     return os.path.splitext(str(path))[1].lower()
 
 
-def read_mesh(path):
+def read_mesh(path: str | os.PathLike) -> Mesh:
     """Read OBJ, OFF, PLY or STL into a :class:`Mesh`.
 
     Raises
@@ -65,6 +61,10 @@ def read_mesh(path):
 
 
 def _read_meshio(path, suffix):
+    import meshio  # only PLY and STL need it; loading it costs a tenth of a second
+
+    failures = (SystemExit, meshio.ReadError, ValueError, IndexError, KeyError, EOFError,
+                TypeError, struct.error)
     if not os.path.isfile(path):
         raise InputError(f"{path}: no such file")
     chatter = io.StringIO()
@@ -73,7 +73,7 @@ def _read_meshio(path, suffix):
         with warnings.catch_warnings(), redirect_stdout(chatter), redirect_stderr(chatter):
             warnings.simplefilter("ignore")
             m = meshio.read(path, file_format="ply" if suffix == ".ply" else "stl")
-    except _MESHIO_FAILURES as exc:
+    except failures as exc:
         detail = str(exc) if not isinstance(exc, SystemExit) else "unrecognized content"
         raise InputError(f"{path}: not a readable {suffix[1:].upper()} file ({detail})") from None
     return mesh_from_meshio(m)
@@ -117,7 +117,7 @@ def _vertex_normals(mesh):
     return out
 
 
-def write_mesh(path, mesh):
+def write_mesh(path: str | os.PathLike, mesh: Mesh) -> list[str]:
     """Write ``mesh`` to ``path`` (format from the extension) atomically.
 
     Returns

@@ -2,7 +2,6 @@
 import hashlib
 import io
 import os
-from importlib.metadata import version
 
 import numpy as np
 
@@ -10,13 +9,14 @@ from ..errors import OutputError
 from ..mesh_io import atomic_write
 from .simplify import CoarseMesh, simplify_to_subset
 
-FORMAT = "srarap-coarse-1"
+#: Names the entry layout and the simplifier's behaviour: change it when either changes.
+FORMAT = "srarap-coarse-2"
 
 
 def cache_key(V, F, size, groups):
     """Hex digest of the mesh, the wanted size, the constrained groups and the simplifier."""
     h = hashlib.sha256()
-    for part in (FORMAT, version("pymeshlab"), str(int(size)), str(len(groups))):
+    for part in (FORMAT, str(int(size)), str(len(groups))):
         h.update(part.encode() + b"\0")
     for array in (np.ascontiguousarray(V, dtype="<f8"), np.ascontiguousarray(F, dtype="<i8"),
                   *(np.ascontiguousarray(g, dtype="<i8") for g in groups)):

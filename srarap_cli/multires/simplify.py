@@ -1,18 +1,17 @@
 """Simplify a triangle mesh to a triangulation of a SUBSET of its own vertices.
 
-MeshLab's quadric edge collapse (through pymeshlab) with optimal placement off moves every
-collapsed edge onto one of its two endpoints, so each coarse vertex sits exactly on a fine
-vertex: the coarse-to-fine map is exact, never a nearest-vertex guess. It is the tool the
-paper's reference implementation used for its coarse meshes. Its planar quadric keeps flat
-regions from collapsing into slivers: on a 50k-vertex faceted bar simplified to 5,000
-vertices, triangles with an angle under 5 degrees drop from 1245 to 60 (no change on the
-smooth cow), and the coarse solve's iterations get cheaper.
+Quadric-error half-edge collapses (:mod:`.collapse`): every collapse deletes one vertex and
+hands its triangles to a neighbour, so each coarse vertex sits exactly on a fine vertex and
+the coarse-to-fine map is exact, never a nearest-vertex guess (the paper's reference
+implementation used MeshLab's collapse with optimal placement off for the same reason).
+Borders slide only along themselves, the link condition keeps the surface manifold, and no
+collapse flips a triangle.
 """
 from dataclasses import dataclass
 
 import numpy as np
-import pymeshlab
 
+from .collapse import collapse_to
 from .topology import topology_summary
 
 
@@ -35,11 +34,8 @@ class CoarseMesh:
 def simplify_to_subset(V, F, size, groups=()):
     """Quadric-error half-edge collapses of (V, F) down to about ``size`` vertices.
 
-    Every group keeps at least one coarse vertex: when the plain simplification empties a
-    group, the mesh is simplified again with one vertex per group protected together with
-    the triangles around it (a vertex the first pass kept if there is one, else the vertex
-    nearest the group's centroid). Protecting only the emptied groups would not do: the
-    second pass may then drop another group's vertices.
+    Every group keeps at least one coarse vertex: its vertex nearest the group's centroid
+    never collapses.
 
     Parameters
     ----------
@@ -65,83 +61,21 @@ def simplify_to_subset(V, F, size, groups=()):
     used = np.zeros(len(V), dtype=bool)
     used[F.ravel()] = True
     groups = [g[used[g]] for g in map(np.asarray, groups)]
-    groups = [g for g in groups if g.size]
-    vertices, faces = _decimate(V, F, size, used, keep=None)
-    if any(not np.isin(g, vertices).any() for g in groups):
-        keep = np.array([_representative(V, g, vertices) for g in groups])
-        vertices, faces = _decimate(V, F, size, used, keep=keep)
-    lost = sum(not np.isin(g, vertices).any() for g in groups)
-    if lost:
-        raise RuntimeError(f"simplification dropped every vertex of {lost} handle group(s)")
-    return CoarseMesh(vertices, faces, _topology_warnings(F, faces, len(V), len(vertices)))
+    frozen = np.zeros(len(V), dtype=bool)
+    frozen[[_representative(V, g) for g in groups if g.size]] = True
+    faces = collapse_to(V, F, max(int(size), 4), frozen)
+    vertices, faces = np.unique(faces, return_inverse=True)
+    faces = faces.reshape(-1, 3)
+    notes = _topology_warnings(F, faces, len(V), len(vertices))
+    if len(vertices) > 1.5 * size and len(vertices) < used.sum():
+        notes.append(f"simplification stopped at {len(vertices)} vertices (asked {size}): "
+                     "no further collapse keeps the surface valid")
+    return CoarseMesh(vertices, faces, notes)
 
 
-def _representative(V, group, kept):
-    """The group's vertex nearest its centroid, preferring vertices ``kept`` already."""
-    pool = group[np.isin(group, kept)]
-    pool = pool if pool.size else group
-    return pool[np.argmin(np.sum((V[pool] - V[group].mean(axis=0)) ** 2, axis=1))]
-
-
-def _decimate(V, F, size, used, keep):
-    """pymeshlab's quadric collapse; returns sorted fine ids and faces indexing them."""
-    mesh = pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32),
-                          v_scalar_array=np.arange(len(V), dtype=float),
-                          f_scalar_array=_collapsible_faces(F, len(V), keep))
-    ms = pymeshlab.MeshSet()
-    ms.add_mesh(mesh)
-    if keep is not None:
-        ms.compute_selection_by_condition_per_face(condselect="fq > 0.5")
-    target = max(4, round(size * len(F) / max(int(used.sum()), 1)))
-    ms.meshing_decimation_quadric_edge_collapse(
-        targetfacenum=target, optimalplacement=False, preservetopology=True,
-        preserveboundary=True, planarquadric=True, autoclean=True, selected=keep is not None)
-    out = ms.current_mesh()
-    ids = _fine_ids(V, out.vertex_matrix(), out.vertex_scalar_array())
-    order = np.argsort(ids)
-    rank = np.empty_like(order)
-    rank[order] = np.arange(order.size)
-    return ids[order], rank[out.face_matrix().astype(np.int64)]
-
-
-def _collapsible_faces(F, n, keep):
-    """Face flags for MeshLab's 'selected only' mode: faces touching a kept vertex stay."""
-    if keep is None:
-        return np.ones(len(F))
-    kept = np.zeros(n, dtype=bool)
-    kept[keep] = True
-    return (~kept[F].any(axis=1)).astype(float)
-
-
-def _fine_ids(V, U, carried):
-    """Fine id of each coarse vertex (U). The carried vertex quality holds the surviving
-    vertex's own id; a collapse may have moved that vertex onto its partner's position, and
-    then the position names the fine vertex (several fine vertices may share it)."""
-    ids = np.rint(carried).astype(np.int64)
-    inside = (ids >= 0) & (ids < len(V))
-    ok = inside.copy()
-    ok[inside] = np.all(V[ids[inside]] == U[inside], axis=1)
-    if not ok.all():
-        ids[~ok] = _by_position(V, U[~ok], set(ids[ok].tolist()))
-    if np.unique(ids).size != ids.size:
-        raise RuntimeError("simplification mapped two coarse vertices to one fine vertex")
-    return ids
-
-
-def _by_position(V, points, taken):
-    """Ids of fine vertices at exactly ``points``, each id used once (rare path: only
-    vertices a collapse moved onto its partner's position)."""
-    where = {}
-    for i, key in enumerate(map(bytes, np.ascontiguousarray(V))):
-        where.setdefault(key, []).append(i)
-    out = []
-    for key in map(bytes, np.ascontiguousarray(points)):
-        free = [i for i in where.get(key, []) if i not in taken]
-        if not free:
-            raise RuntimeError("simplification created a vertex position the mesh lacks")
-        taken.add(free[0])
-        out.append(free[0])
-    return np.array(out, dtype=np.int64)
+def _representative(V, group):
+    """The group's vertex nearest its centroid."""
+    return group[np.argmin(np.sum((V[group] - V[group].mean(axis=0)) ** 2, axis=1))]
 
 
 def _topology_warnings(F, G, n, m):

@@ -1,0 +1,323 @@
+"""Quadric-error half-edge collapses, in rounds of independent collapses (vectorized).
+
+A half-edge collapse u -> v deletes u and hands its triangles to v, so every surviving vertex
+keeps its original position: the result triangulates a subset of the input's vertices, which
+is what the multiresolution transfer needs (paper section 7). No permissive library offers
+this (libigl, fast-simplification and pyfqmr move the merged vertex), hence this module.
+
+Each round every free vertex u proposes its cheapest *valid* collapse (link condition kept,
+no triangle flipped or degenerated), then a set of proposals whose closed one-rings are
+pairwise disjoint is applied at once. Disjoint rings make the collapses independent: none
+changes the faces, neighbours or quadrics another one was checked against, and no vertex
+moves, so every check made at the start of the round still holds when all are applied.
+"""
+import numpy as np
+
+#: Weight of the point quadric (distance to the collapsed original vertices) relative to the
+#: plane quadrics, per unit of vertex area: it breaks ties on flat regions in favour of short
+#: collapses and compact clusters, so flat parts do not collapse into slivers (the role of
+#: MeshLab's planar quadric, whose default weight is also 1e-3).
+POINT_WEIGHT = 1e-3
+#: Only the cheapest part of the proposals competes in a round, so that collapses happen
+#: roughly in cost order, as in a global greedy simplification.
+CHEAPEST = 0.5
+#: A collapse may turn no remaining triangle's normal by more than about 80 degrees, nor
+#: away from the input surface's normals at its corners.
+MIN_NORMAL_COS = 0.17
+#: Nor make a triangle whose shape quality 4 sqrt(3) area / (sum of squared edge lengths)
+#: (1 for an equilateral one) is under this and under the worst of the triangles it replaces.
+MIN_QUALITY = 0.3
+#: Selection passes per round (each adds collapses away from those already chosen).
+PASSES = 8
+
+
+def collapse_to(V, F, size, frozen):
+    """Collapse (V, F) until at most ``size`` vertices remain or nothing can collapse.
+
+    Parameters
+    ----------
+    V : (n, 3) float array
+    F : (f, 3) int array, triangles without repeated vertices
+    size : int, wanted number of vertices
+    frozen : (n,) bool array, vertices that must survive
+
+    Returns
+    -------
+    (g, 3) int array, the remaining triangles, indexing V
+
+    Examples
+    --------
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0]])
+    >>> F = np.array([[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]])
+    >>> np.unique(collapse_to(V, F, 4, np.zeros(6, bool))).tolist()
+    [0, 2, 3, 5]
+    """
+    V = np.asarray(V, dtype=float)
+    F = np.asarray(F, dtype=np.int64)
+    Q = _vertex_quadrics(V, F)
+    surface = _vertex_normals(V, F)
+    lifted = _lifted(V)
+    alive = np.unique(F).size
+    banned = np.empty(0, dtype=np.int64)
+    while alive > size:
+        u, v, invalid = _round(V, lifted, surface, F, Q, frozen, banned, alive - size)
+        if not u.size:
+            if not banned.size:
+                break
+            # proposals found invalid earlier may have become valid since
+            banned = np.empty(0, dtype=np.int64)
+            continue
+        banned = np.union1d(banned, invalid)
+        Q[v] += Q[u]
+        relabel = np.arange(len(V))
+        relabel[u] = v
+        F = relabel[F]
+        F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
+        alive -= u.size
+    return F
+
+
+def _round(V, lifted, surface, F, Q, frozen, banned, need):
+    """One round: the vertices to delete, the vertices they collapse into, and the keys
+    (u n + v) of proposals that won but failed the checks (left out of later rounds).
+
+    Checks run only on the winners: most proposals pass them, and checking every vertex's
+    proposal each round cost several times the rest of the round."""
+    n = len(V)
+    edges, count = _edges(F, n)
+    fixed = frozen.copy()
+    fixed[edges[count > 2].ravel()] = True
+    border = np.zeros(n, dtype=bool)
+    border[edges[count == 1].ravel()] = True
+    u = np.concatenate([edges[:, 0], edges[:, 1]])
+    v = np.concatenate([edges[:, 1], edges[:, 0]])
+    c = np.concatenate([count, count])
+    # a border vertex may only slide along the border, so boundaries keep their shape
+    ok = ~fixed[u] & (c <= 2) & (~border[u] | (c == 1)) & ~_isin_sorted(u * n + v, banned)
+    u, v, c = u[ok], v[ok], c[ok]
+    cost = _costs(Q, lifted, u, v)
+    first = _cheapest_per_vertex(u, v, cost, n)
+    u, v, c, cost = u[first], v[first], c[first], cost[first]
+    if u.size > 1:
+        keep = cost <= np.quantile(cost, CHEAPEST)
+        u, v, c, cost = u[keep], v[keep], c[keep], cost[keep]
+    rank = np.lexsort((u, cost))
+    u, v, c = u[rank], v[rank], c[rank]
+    rings = _Rings(edges, F, n)
+    win = _independent(rings, u, v, n)
+    u, v, c = u[win], v[win], c[win]
+    good = rings.link_ok(u, v, c) & _keeps_shape(V, surface, rings, u, v)
+    invalid = u[~good] * n + v[~good]
+    u, v = u[good][:need], v[good][:need]
+    return u, v, invalid
+
+
+def _cheapest_per_vertex(u, v, cost, n):
+    """Index of each u's cheapest proposal (ties: smallest v), in increasing u."""
+    best = np.full(n, np.inf)
+    np.minimum.at(best, u, cost)
+    tied = np.flatnonzero(cost == best[u])
+    low = np.full(n, n)
+    np.minimum.at(low, u[tied], v[tied])
+    pick = tied[v[tied] == low[u[tied]]]
+    return pick[np.argsort(u[pick], kind="stable")]
+
+
+def _isin_sorted(keys, table):
+    """Whether each key is in the sorted array ``table``."""
+    if not table.size:
+        return np.zeros(keys.shape, dtype=bool)
+    at = np.minimum(np.searchsorted(table, keys), table.size - 1)
+    return table[at] == keys
+
+
+def _independent(rings, u, v, n):
+    """Indices (in priority order) of proposals that can be applied together; ``u`` is
+    sorted by priority. Two collapses interfere when one's u or v lies in the other's closed
+    one-ring N[u] (that ring's faces, neighbours and link are what the other changes). A
+    proposal wins where no better one touches its ring and no better ring holds its u or v;
+    the passes repeat this among proposals clear of the winners."""
+    owner, member = rings.closed(u)
+    touch_owner = np.tile(np.arange(u.size), 2)
+    touch = np.concatenate([u, v])
+    won = np.zeros(u.size, dtype=bool)
+    ring_taken = np.zeros(n, dtype=bool)
+    touch_taken = np.zeros(n, dtype=bool)
+    for _ in range(PASSES):
+        hit = (_any(owner, touch_taken[member], u.size)
+               | _any(touch_owner, ring_taken[touch], u.size))
+        live = ~won & ~hit
+        if not live.any():
+            break
+        prio = np.where(live, np.arange(u.size), u.size)
+        best_ring = np.full(n, u.size)
+        np.minimum.at(best_ring, member, prio[owner])
+        best_touch = np.full(n, u.size)
+        np.minimum.at(best_touch, touch, prio[touch_owner])
+        lost = (_any(owner, best_touch[member] < prio[owner], u.size)
+                | _any(touch_owner, best_ring[touch] < prio[touch_owner], u.size))
+        new = live & ~lost
+        won |= new
+        ring_taken[member[new[owner]]] = True
+        touch_taken[touch[new[touch_owner]]] = True
+    return np.flatnonzero(won)
+
+
+def _any(owner, flags, size):
+    """Per owner, whether any of its flags is set."""
+    return np.bincount(owner, weights=flags, minlength=size) > 0
+
+
+def _keeps_shape(V, surface, rings, u, v):
+    """Whether moving u's triangles onto v keeps each one's orientation (against the
+    triangle it was and against the input surface) and a fair shape."""
+    owner, faces = rings.star(u)
+    T = rings.F[faces]
+    keep = ~np.any(T == v[owner, None], axis=1)
+    owner, T = owner[keep], T[keep]
+    before = _normals(V, T)
+    worst = np.full(u.size, np.inf)
+    np.minimum.at(worst, owner, _quality(V, T, before))
+    T = np.where(T == u[owner, None], v[owner, None], T)
+    after = _normals(V, T)
+    size_b = np.linalg.norm(before, axis=1)
+    size_a = np.linalg.norm(after, axis=1)
+    good = ((np.einsum("ij,ij->i", before, after) > MIN_NORMAL_COS * size_b * size_a)
+            & (np.einsum("ij,ij->i", after, surface[T].sum(axis=1)) > 0)
+            & (size_a > 1e-12 * size_b)
+            & (_quality(V, T, after) >= np.minimum(MIN_QUALITY, worst[owner])))
+    return ~_any(owner, ~good, u.size)
+
+
+def _quality(V, T, normal):
+    """4 sqrt(3) area / sum of squared edge lengths, per triangle."""
+    edges = np.stack([V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 1]],
+                      V[T[:, 0]] - V[T[:, 2]]], axis=1)
+    return 2 * np.sqrt(3) * np.linalg.norm(normal, axis=1) / np.maximum(
+        np.einsum("ijk,ijk->i", edges, edges), 1e-300)
+
+
+def _vertex_normals(V, F):
+    """Area-weighted unit vertex normals of the input surface."""
+    normal = _normals(V, F)
+    out = _sum_into(F.ravel(), np.repeat(normal, 3, axis=0), len(V))
+    return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
+
+
+class _Rings:
+    """Neighbours and incident triangles of each vertex of the current mesh (CSR)."""
+
+    def __init__(self, edges, F, n):
+        self.F = F
+        keys = np.concatenate([edges[:, 0] * n + edges[:, 1], edges[:, 1] * n + edges[:, 0]])
+        self.keys = np.sort(keys)
+        self.nbr = self.keys % n
+        self.n = n
+        self.nbr_ptr = np.searchsorted(self.keys, np.arange(n + 1) * n)
+        corner = F.ravel()
+        order = np.argsort(corner, kind="stable")
+        self.face = order // 3
+        self.face_ptr = np.searchsorted(corner[order], np.arange(n + 1))
+
+    def closed(self, u):
+        """(owner, member) pairs: member runs over u[owner] and its neighbours."""
+        owner, member = _segments(self.nbr_ptr, self.nbr, u)
+        return np.concatenate([np.arange(u.size), owner]), np.concatenate([u, member])
+
+    def star(self, u):
+        """(owner, face) pairs: the triangles around u[owner]."""
+        return _segments(self.face_ptr, self.face, u)
+
+    def link_ok(self, u, v, c):
+        """Link condition: u and v share exactly the neighbours opposite their edge (two
+        inside, one on the border); more would pinch the surface when they merge."""
+        owner, w = _segments(self.nbr_ptr, self.nbr, u)
+        common = np.bincount(owner, weights=_isin_sorted(v[owner] * self.n + w, self.keys),
+                             minlength=u.size)
+        return common == c
+
+
+def _segments(ptr, values, rows):
+    """(owner, value) pairs for the CSR rows ``rows``."""
+    lengths = ptr[rows + 1] - ptr[rows]
+    owner = np.repeat(np.arange(rows.size), lengths)
+    offset = np.arange(owner.size) - np.repeat(np.cumsum(lengths) - lengths, lengths)
+    return owner, values[ptr[rows][owner] + offset]
+
+
+def _edges(F, n):
+    """Undirected edges (sorted pairs) and how many triangles hold each."""
+    a = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    b = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    keys, count = np.unique(np.minimum(a, b) * n + np.maximum(a, b), return_counts=True)
+    return np.stack([keys // n, keys % n], axis=1), count
+
+
+def _normals(V, T):
+    return np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]])
+
+
+def _vertex_quadrics(V, F):
+    """(n, 10) upper triangles of each vertex's 4x4 error quadric: area-weighted planes of
+    its triangles, planes through border edges perpendicular to their triangle, and a small
+    point quadric at the vertex."""
+    n = len(V)
+    normal = _normals(V, F)
+    double_area = np.linalg.norm(normal, axis=1)
+    unit = normal / np.maximum(double_area, 1e-300)[:, None]
+    planes = np.column_stack([unit, -np.einsum("ij,ij->i", unit, V[F[:, 0]])])
+    Q = np.zeros((n, 10))
+    face_q = _outer(planes) * (double_area / 6)[:, None]
+    for k in range(3):
+        Q += _sum_into(F[:, k], face_q, n)
+    Q += _border_quadrics(V, F, unit, n)
+    area = np.bincount(F.ravel(), weights=np.repeat(double_area / 6, 3), minlength=n)
+    point = np.column_stack([np.ones(n), np.zeros(n), np.zeros(n), -V[:, 0], np.ones(n),
+                             np.zeros(n), -V[:, 1], np.ones(n), -V[:, 2],
+                             np.einsum("ij,ij->i", V, V)])
+    return Q + point * (POINT_WEIGHT * area)[:, None]
+
+
+def _border_quadrics(V, F, unit, n):
+    a = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    b = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    face = np.tile(np.arange(len(F)), 3)
+    key = np.minimum(a, b) * n + np.maximum(a, b)
+    _, inverse, count = np.unique(key, return_inverse=True, return_counts=True)
+    lone = count[inverse] == 1
+    a, b, face = a[lone], b[lone], face[lone]
+    along = V[b] - V[a]
+    length2 = np.einsum("ij,ij->i", along, along)
+    side = np.cross(along, unit[face])
+    side /= np.maximum(np.linalg.norm(side, axis=1), 1e-300)[:, None]
+    q = _outer(np.column_stack([side, -np.einsum("ij,ij->i", side, V[a])])) * length2[:, None]
+    return _sum_into(a, q, n) + _sum_into(b, q, n)
+
+
+def _outer(p):
+    """Upper triangles (row-major, 10 entries) of the outer products p p^T, p (m, 4)."""
+    i, j = np.triu_indices(4)
+    return p[:, i] * p[:, j]
+
+
+def _sum_into(index, values, n):
+    return np.column_stack([np.bincount(index, weights=values[:, k], minlength=n)
+                            for k in range(values.shape[1])])
+
+
+def _lifted(V):
+    """(n, 10) monomials of (x, 1) matching the upper-triangle quadric layout, off-diagonal
+    ones doubled, so that a quadric's error at x is a dot product."""
+    i, j = np.triu_indices(4)
+    x = np.column_stack([V, np.ones(len(V))])
+    return x[:, i] * x[:, j] * np.where(i == j, 1.0, 2.0)
+
+
+def _costs(Q, lifted, u, v, chunk=1 << 20):
+    """Quadric error of moving u onto v: (v,1)^T (Q_u + Q_v) (v,1)."""
+    own = np.einsum("ik,ik->i", Q, lifted)
+    out = np.empty(u.size)
+    for s in range(0, u.size, chunk):
+        uu, vv = u[s:s + chunk], v[s:s + chunk]
+        out[s:s + chunk] = np.einsum("ik,ik->i", Q[uu], lifted[vv]) + own[vv]
+    return np.maximum(out, 0.0)

@@ -1,0 +1,68 @@
+"""Half-edge collapses: a subset of the vertices, a valid surface, the same shape."""
+import igl
+import numpy as np
+import pytest
+
+from srarap_cli.multires.collapse import collapse_to
+from srarap_cli.multires.simplify import _octahedron
+from srarap_cli.multires.topology import topology_summary
+
+
+def grid(k):
+    """A flat k x k vertex grid on the unit square, triangles facing +z."""
+    x, y = np.meshgrid(np.linspace(0, 1, k), np.linspace(0, 1, k))
+    V = np.column_stack([x.ravel(), y.ravel(), np.zeros(k * k)])
+    i = np.arange(k - 1)
+    a = (i[:, None] * k + i[None, :]).ravel()
+    F = np.vstack([np.column_stack([a, a + 1, a + k + 1]), np.column_stack([a, a + k + 1, a + k])])
+    return V, F
+
+
+def normals(V, F):
+    return np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+
+
+def test_a_flat_square_keeps_its_outline_orientation_and_area():
+    V, F = grid(15)
+    G = collapse_to(V, F, 40, np.zeros(len(V), bool))
+    kept = np.unique(G)
+    assert len(kept) <= 40
+    n = normals(V, G)
+    assert np.all(n[:, 2] > 0) and np.allclose(n[:, :2], 0)  # nothing flipped or tilted
+    # borders slide only along themselves: the four corners stay and the area is exact
+    corners = [0, 14, 210, 224]
+    assert np.isin(corners, kept).all()
+    assert np.isclose(0.5 * n[:, 2].sum(), 1.0, rtol=1e-12)
+    before, after = topology_summary(F, len(V)), topology_summary(G, len(V))
+    assert before == after
+
+
+def test_frozen_vertices_survive_and_the_rest_is_a_subset():
+    V, F = igl.loop(*igl.loop(*_octahedron()))
+    frozen = np.zeros(len(V), bool)
+    frozen[[7, 30, 55]] = True
+    G = collapse_to(V, F, 12, frozen)
+    kept = np.unique(G)
+    assert np.isin([7, 30, 55], kept).all() and len(kept) <= 12
+    assert G.min() >= 0 and G.max() < len(V)
+    assert topology_summary(G, len(V))["euler"] == 2
+
+
+def test_asking_for_too_little_stops_at_a_valid_closed_surface():
+    V, F = igl.loop(*_octahedron())
+    G = collapse_to(V, F, 1, np.zeros(len(V), bool))
+    summary = topology_summary(G, len(V))
+    assert summary["euler"] == 2 and summary["edge_manifold"] and summary["components"] == 1
+    assert 4 <= len(np.unique(G)) < len(V)
+    assert np.all(np.einsum("ij,ij->i", normals(V, G), V[G].mean(axis=1)) > 0)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_every_coarse_triangle_faces_the_way_the_surface_does(seed):
+    V, F = igl.loop(*igl.loop(*igl.loop(*_octahedron())))
+    rng = np.random.default_rng(seed)
+    V = V / np.linalg.norm(V, axis=1)[:, None] * (1 + 0.05 * rng.random((len(V), 1)))
+    G = collapse_to(V, F, 40, np.zeros(len(V), bool))
+    centroid = V[G].mean(axis=1)
+    assert np.all(np.einsum("ij,ij->i", normals(V, G), centroid) > 0)  # outward, like F
+    assert topology_summary(G, len(V)) == topology_summary(F, len(V))
