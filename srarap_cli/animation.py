@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import InputError
+from .input_files import read_input_bytes
 from .pipeline import build_deformer, problem, scatter
 from .quaternion import align_hemisphere
 
@@ -106,7 +107,6 @@ def fingerprint(paths, opts, *extra):
     decides the frames (``extra``, JSON-serializable): a resume state belongs to one run."""
     h = hashlib.sha256()
     for path in paths:
-        with open(path, "rb") as fh:
-            h.update(hashlib.sha256(fh.read()).digest())
+        h.update(hashlib.sha256(read_input_bytes(path)).digest())
     h.update(json.dumps([opts, *extra], sort_keys=True).encode())
     return h.hexdigest()

@@ -22,11 +22,11 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from importlib import metadata
 
-import yaml
-
 from .compare import compare_meshes
+from .documents import load_document
 from .errors import InputError
 from .handles import load_handles
+from .input_files import read_input_bytes
 from .mesh_io import format_mesh, read_mesh
 from .mesh_io.commit import commit_files
 from .pipeline import deform_mesh
@@ -38,13 +38,7 @@ SUMMARY_FIELDS = ("job", "status", "iterations", "energy", "seconds", "compare_m
 
 def load_manifest(path):
     """Jobs of a manifest, with absolute paths and merged settings (list of dict)."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            doc = json.load(fh) if path.lower().endswith(".json") else yaml.safe_load(fh)
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
-    except (ValueError, yaml.YAMLError) as exc:
-        raise InputError(f"{path}: not a valid manifest ({str(exc).splitlines()[0]})") from None
+    doc = load_document(path, "json" if path.lower().endswith(".json") else "yaml")
     if not isinstance(doc, dict) or not isinstance(doc.get("jobs"), list) or not doc["jobs"]:
         raise InputError(f"{path}: a manifest needs a non-empty 'jobs' list")
     base = os.path.dirname(os.path.abspath(path))
@@ -87,9 +81,8 @@ def referenced_files(handles):
     if handles.lower().endswith(".sel"):
         return [os.path.splitext(handles)[0] + ".def"]
     try:
-        with open(handles, encoding="utf-8") as fh:
-            doc = yaml.safe_load(fh)  # JSON is YAML too
-    except (OSError, ValueError, yaml.YAMLError):
+        doc = load_document(handles, "yaml")  # JSON is YAML too
+    except InputError:
         return []
     found, stack = [], [doc]
     while stack:
@@ -108,9 +101,8 @@ def fingerprint(job):
     h = hashlib.sha256()
     for path in (job["mesh"], job["handles"], *referenced_files(job["handles"])):
         try:
-            with open(path, "rb") as fh:
-                h.update(hashlib.sha256(fh.read()).digest())
-        except OSError:
+            h.update(hashlib.sha256(read_input_bytes(path)).digest())
+        except InputError:
             h.update(b"missing:" + path.encode())
     h.update(json.dumps([job["settings"], job["output"], metadata.version("srarap-cli")],
                         sort_keys=True).encode())

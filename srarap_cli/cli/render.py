@@ -105,8 +105,9 @@ def plot(logs, out, size):
 
 def _read_log(path):
     from ..errors import InputError
+    from ..input_files import open_input
     try:
-        with open(path, encoding="utf-8") as fh:
+        with open_input(path, encoding="utf-8") as fh:
             if path.lower().endswith(".csv"):
                 rows = list(csv.DictReader(fh))
             else:

@@ -4,13 +4,12 @@ YAML or JSON (same schema), or a Botsch-Sorkine ``.sel`` file with its ``.def`` 
 The schema is documented in the README; :func:`load_handles` validates it and reports each
 problem as one line naming the file, group and field.
 """
-import json
 import os
 from dataclasses import dataclass, field
 
 import numpy as np
-import yaml
 
+from ..documents import load_document
 from ..errors import InputError
 from ..settings import parse_mapping
 from .fields import Context
@@ -86,16 +85,7 @@ def _load_document(path):
     ext = os.path.splitext(path)[1].lower()
     if ext not in (".yaml", ".yml", ".json"):
         raise InputError(f"{path}: handle file must be .yaml, .yml, .json or .sel")
-    try:
-        with open(path, encoding="utf-8") as fh:
-            return json.load(fh) if ext == ".json" else yaml.safe_load(fh)
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
-    except (ValueError, yaml.YAMLError) as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        mark = getattr(exc, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark is not None else ""
-        raise InputError(f"{path}: not valid {ext[1:].upper()}{where}: {first}") from None
+    return load_document(path, "json" if ext == ".json" else "yaml")
 
 
 def parse_handles(doc, V, path="<handles>", base=".", fps=None):

@@ -1,16 +1,16 @@
 """Constraint files used in the field: Botsch-Sorkine ``.sel``/``.def`` and libigl ``.dmat``."""
-import os
 
 import numpy as np
 
 from ..errors import InputError
+from ..input_files import open_input
 
 SEL_STATUS = {"fixed": 0, "free": 1, "handle": 2}
 
 
 def _numbers(path, dtype):
     try:
-        with open(path, encoding="utf-8", errors="replace") as fh:
+        with open_input(path, encoding="utf-8", errors="replace") as fh:
             text = " ".join(line.split("#", 1)[0] for line in fh)
     except OSError as exc:
         raise InputError(f"{path}: cannot read: {exc.strerror}") from None
@@ -43,9 +43,7 @@ def read_dmat(path):
     -------
     (rows,) int array for a one-column file
     """
-    if not os.path.isfile(path):
-        raise InputError(f"{path}: no such file")
-    with open(path, "rb") as fh:
+    with open_input(path, "rb") as fh:
         head = fh.readline().split()
         body = fh.read()
     try:

@@ -1,7 +1,7 @@
 """Read and write meshes, keeping vertex order, polygons, UVs and normals.
 
-OBJ and OFF are parsed here (meshio fails on common variants of both); PLY and STL are
-read with meshio. Writers are deterministic (no timestamps) and atomic (temporary file in
+OBJ, OFF and PLY are parsed here (meshio fails on common variants of OBJ and OFF, and trusts
+PLY headers); STL is read with meshio. Writers are deterministic (no timestamps) and atomic (temporary file in
 the target folder, then rename), so a failed run never leaves a partial file behind.
 """
 import io
@@ -20,6 +20,7 @@ from .normals import recompute_normals
 from .obj import format_obj, read_obj
 from .off import format_off, read_off
 from .ply import format_ply, mesh_from_meshio, per_vertex
+from .ply_read import read_ply
 
 READ_FORMATS = (".obj", ".off", ".ply", ".stl")
 WRITE_FORMATS = (".obj", ".off", ".ply")
@@ -50,6 +51,8 @@ def read_mesh(path: str | os.PathLike) -> Mesh:
             mesh = read_obj(path)
         elif suffix == ".off":
             mesh = read_off(path)
+        elif suffix == ".ply":
+            mesh = read_ply(path)
         else:
             mesh = _read_meshio(path, suffix)
     except InputError:
@@ -61,7 +64,7 @@ def read_mesh(path: str | os.PathLike) -> Mesh:
 
 
 def _read_meshio(path, suffix):
-    import meshio  # only PLY and STL need it; loading it costs a tenth of a second
+    import meshio  # only STL needs it; loading it costs a tenth of a second
 
     failures = (SystemExit, meshio.ReadError, ValueError, IndexError, KeyError, EOFError,
                 TypeError, struct.error)
@@ -72,7 +75,7 @@ def _read_meshio(path, suffix):
         # meshio prints its own message and calls sys.exit() on some files it cannot read
         with warnings.catch_warnings(), redirect_stdout(chatter), redirect_stderr(chatter):
             warnings.simplefilter("ignore")
-            m = meshio.read(path, file_format="ply" if suffix == ".ply" else "stl")
+            m = meshio.read(path, file_format="stl")
     except failures as exc:
         detail = str(exc) if not isinstance(exc, SystemExit) else "unrecognized content"
         raise InputError(f"{path}: not a readable {suffix[1:].upper()} file ({detail})") from None

@@ -6,6 +6,7 @@ per-corner normals, and libigl's reader keeps no polygons of mixed size or other
 import numpy as np
 
 from ..errors import InputError
+from ..input_files import open_input
 from .mesh import Mesh
 
 
@@ -35,7 +36,7 @@ def _corner(token, counts, path, lineno):
 def read_obj(path):
     """Read an OBJ file into a :class:`Mesh`, keeping vertex and face order."""
     verts, uvs, norms, sizes, faces, statements = [], [], [], [], [], []
-    with open(path, encoding="utf-8", errors="replace") as fh:
+    with open_input(path, encoding="utf-8", errors="replace") as fh:
         text = fh.read().replace("\\\n", " ")
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()

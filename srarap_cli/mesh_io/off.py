@@ -6,11 +6,12 @@ in the count line) and libigl's triangulates polygons away.
 import numpy as np
 
 from ..errors import InputError
+from ..input_files import open_input
 from .mesh import Mesh
 
 
 def _tokens(path):
-    with open(path, encoding="utf-8", errors="replace") as fh:
+    with open_input(path, encoding="utf-8", errors="replace") as fh:
         for line in fh:
             line = line.split("#", 1)[0].split()
             if line:

@@ -1,4 +1,4 @@
-"""PLY (read through meshio, written here) and STL (read through meshio).
+"""PLY writer (the reader is :mod:`.ply_read`) and STL through meshio.
 
 meshio stamps the current time into PLY headers it writes; this writer does not, so the
 same mesh always gives the same bytes.

@@ -1,0 +1,153 @@
+"""Hostile input: no crash, no hang, no blow-up, one InputError naming the file."""
+import os
+import struct
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from helpers import tube_mesh
+
+from srarap_cli.errors import InputError
+from srarap_cli.handles import load_handles
+from srarap_cli.mesh_io import read_mesh, write_mesh
+
+
+def ply_header(fmt, n_vertices, n_faces, count="uchar", extra=""):
+    return (f"ply\nformat {fmt} 1.0\nelement vertex {n_vertices}\nproperty float x\n"
+            f"property float y\nproperty float z\n{extra}element face {n_faces}\n"
+            f"property list {count} int vertex_indices\nend_header\n").encode()
+
+
+def binary_faces(faces):
+    return b"".join(struct.pack("<B", len(f)) + struct.pack(f"<{len(f)}i", *f) for f in faces)
+
+
+VERTS = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+
+
+@pytest.mark.parametrize("name, data, message", [
+    ("zero.ply", ply_header("binary_little_endian", 3, 2) + VERTS
+     + binary_faces([[0, 1, 2], []]), "face 1 has 0 corners"),
+    ("zero-ascii.ply", ply_header("ascii", 3, 1) + b"0 0 0\n1 0 0\n0 1 0\n0\n",
+     "face 0 has 0 corners"),
+    ("two.ply", ply_header("binary_little_endian", 3, 1) + VERTS + binary_faces([[0, 1]]),
+     "face 0 has 2 corners"),
+    ("noend.ply", b"ply\nformat ascii 1.0\nelement vertex 3\n" + b"comment x\n" * 20000,
+     "no 'end_header'"),
+    ("huge-vertex.ply", ply_header("binary_little_endian", 2147483647, 1) + VERTS,
+     "declares 2147483647 entries"),
+    ("huge-face.ply", ply_header("binary_little_endian", 3, 100000000) + VERTS
+     + binary_faces([[0, 1, 2]]), "declares 100000000 entries"),
+    ("columns.ply", ply_header("ascii", 3, 1) + b"0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n",
+     "vertex 0 has 4 values, the header declares 3"),
+    ("float-index.ply", ply_header("ascii", 3, 1) + b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2.5\n",
+     "non-integer"),
+    ("cut.ply", ply_header("binary_little_endian", 3, 2) + VERTS + binary_faces([[0, 1, 2]])
+     + b"\x03\x00", "declares 2 entries|cut off"),
+    ("nomagic.ply", b"PLX\nformat ascii 1.0\nend_header\n", "no 'ply' magic"),
+    ("badline.ply", b"ply\nformat ascii 1.0\nelement vertex many\nend_header\n",
+     "bad PLY header line"),
+])
+def test_broken_ply_files_are_one_input_error_quickly(tmp_path, name, data, message):
+    path = tmp_path / name
+    path.write_bytes(data)
+    start = time.perf_counter()
+    with pytest.raises(InputError, match=message) as err:
+        read_mesh(str(path))
+    assert time.perf_counter() - start < 5  # a bound against hangs, not a benchmark
+    assert str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+def test_ply_reader_keeps_polygons_of_mixed_size_in_both_byte_orders(tmp_path):
+    mesh = tube_mesh(rings=3, segments=5)  # quads and triangle fans
+    path = tmp_path / "m.ply"
+    write_mesh(str(path), mesh)
+    back = read_mesh(str(path))
+    assert np.array_equal(back.face_sizes, mesh.face_sizes)
+    assert np.array_equal(back.face_vertices, mesh.face_vertices)
+    assert np.array_equal(back.vertices, mesh.vertices)
+    data = path.read_bytes()
+    head, _, body = data.partition(b"end_header\n")
+    n = len(mesh.vertices)
+    names = [line.split()[2] for line in head.decode().splitlines()
+             if line.startswith("property double")]
+    assert names[:3] == ["x", "y", "z"]
+    table = np.frombuffer(body, dtype=[(k, "<f8") for k in names], count=n)
+    big = table.astype([(k, ">f8") for k in names]).tobytes()
+    faces = b"".join(struct.pack(">B", s) + struct.pack(f">{s}i", *f) for s, f in zip(
+        mesh.face_sizes, np.split(mesh.face_vertices, np.cumsum(mesh.face_sizes)[:-1])))
+    (tmp_path / "big.ply").write_bytes(
+        head.replace(b"binary_little_endian", b"binary_big_endian") + b"end_header\n" + big
+        + faces)
+    other = read_mesh(str(tmp_path / "big.ply"))
+    assert np.array_equal(other.vertices, mesh.vertices)
+    assert np.array_equal(other.face_vertices, mesh.face_vertices)
+
+
+def test_ascii_ply_with_extra_vertex_properties_reads(tmp_path):
+    path = tmp_path / "a.ply"
+    path.write_bytes(b"ply\nformat ascii 1.0\ncomment hi\nelement vertex 4\nproperty float x\n"
+                     b"property float y\nproperty float z\nproperty uchar red\n"
+                     b"element face 1\nproperty list uchar int vertex_index\nend_header\n"
+                     b"0 0 0 1\n1 0 0 2\n1 1 0 3\n0 1 0 4\n4 0 1 2 3\n")
+    m = read_mesh(str(path))
+    assert m.face_sizes.tolist() == [4] and m.vertex_data["red"].tolist() == [1, 2, 3, 4]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this system")
+@pytest.mark.parametrize("kind", ["mesh.obj", "mesh.ply", "handles.yaml", "handles.sel"])
+def test_a_fifo_or_device_is_refused_without_blocking(tmp_path, kind):
+    fifo = tmp_path / kind
+    os.mkfifo(fifo)
+    mesh_path = tmp_path / "ok.obj"
+    write_mesh(str(mesh_path), tube_mesh(rings=3, segments=5))
+    code = ("import sys\nfrom srarap_cli.errors import InputError\n"
+            "from srarap_cli.mesh_io import read_mesh\nfrom srarap_cli.handles import load_handles\n"
+            "try:\n"
+            f"    if {kind!r}.startswith('mesh'): read_mesh({str(fifo)!r})\n"
+            f"    else: load_handles({str(fifo)!r}, read_mesh({str(mesh_path)!r}).vertices)\n"
+            "except InputError as e: print(e)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=60).stdout
+    assert "not a regular file" in out
+    with pytest.raises(InputError, match="not a regular file"):
+        read_mesh(_link(tmp_path, "/dev/zero"))  # a device behind a symlink
+
+
+def _link(tmp_path, target):
+    link = tmp_path / "zero.obj"
+    if not link.exists():
+        link.symlink_to(target)
+    return str(link)
+
+
+def alias_bomb(levels=9, width=9):
+    lines = ["a0: &a0 [1, 2, 3, 4, 5, 6, 7, 8, 9]"]
+    for k in range(1, levels):
+        lines.append(f"a{k}: &a{k} [" + ", ".join([f"*a{k - 1}"] * width) + "]")
+    return "\n".join(lines) + "\ngroups: {}\n"
+
+
+@pytest.mark.parametrize("name, text, message", [
+    ("bomb.yaml", alias_bomb(), "expands to more than"),
+    ("deep.yaml", "groups: " + "[" * 1000 + "]" * 1000 + "\n", "nested too deeply"),
+    ("deep.json", '{"groups": ' + "[" * 5000 + "]" * 5000 + "}", "nested too deeply"),
+])
+def test_yaml_bombs_and_deep_nesting_are_refused_quickly(tmp_path, name, text, message):
+    path = tmp_path / name
+    path.write_text(text)
+    start = time.perf_counter()
+    with pytest.raises(InputError, match=message):
+        load_handles(str(path), np.zeros((3, 3)))
+    assert time.perf_counter() - start < 5
+
+
+def test_aliases_within_bounds_still_work(tmp_path):
+    path = tmp_path / "h.yaml"
+    path.write_text("groups:\n  a: {indices: [0], fixed: true}\n"
+                    "  b: {indices: [1], translate: &up [0, 0, 1]}\n"
+                    "  c: {indices: [2], translate: *up}\n")
+    c = load_handles(str(path), np.eye(3))
+    assert np.allclose(c.targets, np.eye(3) + [[0, 0, 0], [0, 0, 1], [0, 0, 1]])
