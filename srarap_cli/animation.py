@@ -56,12 +56,13 @@ class Animator:
     constraints : Constraints, with ``tracks`` for the keyframed groups
     opts : dict, resolved solver settings (see ``pipeline.settings``)
     cache : str, optional, folder for multiresolution coarse meshes
+    name : str, the mesh's file, for error messages
     """
 
-    def __init__(self, mesh, constraints, opts, cache=None):
+    def __init__(self, mesh, constraints, opts, cache=None, name="mesh"):
         self.mesh = mesh
         self.constraints = constraints
-        self.problem = problem(mesh, constraints)
+        self.problem = problem(mesh, constraints, name)
         self.deformer = build_deformer(self.problem, opts, cache)
         self.solve_options = {"accel": opts["accel"], "start": opts["start"]}
         self.last_result = None

@@ -17,6 +17,7 @@ srarap version).
 """
 import hashlib
 import json
+import math
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -24,10 +25,10 @@ from importlib import metadata
 
 from .compare import compare_meshes
 from .documents import load_document
-from .errors import InputError
+from .errors import InputError, excerpt
 from .handles import load_handles
 from .input_files import read_input_bytes
-from .mesh_io import format_mesh, read_mesh
+from .mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from .mesh_io.commit import commit_files
 from .pipeline import deform_mesh
 from .settings import parse_mapping
@@ -43,7 +44,7 @@ def load_manifest(path):
         raise InputError(f"{path}: a manifest needs a non-empty 'jobs' list")
     base = os.path.dirname(os.path.abspath(path))
     defaults = _settings(path, "defaults", doc.get("defaults", {}))
-    jobs, names = [], set()
+    jobs, names, outputs = [], set(), set()
     for k, job in enumerate(doc["jobs"]):
         where = f"{path}: job {k}"
         if not isinstance(job, dict) or not {"mesh", "handles", "output"} <= set(job):
@@ -51,7 +52,11 @@ def load_manifest(path):
         unknown = sorted(set(job) - set(JOB_KEYS))
         if unknown:
             raise InputError(f"{where}: unknown key {unknown[0]!r}")
-        name = str(job.get("name", os.path.splitext(str(job["output"]))[0]))
+        output = _output_name(where, job["output"])
+        if output in outputs:
+            raise InputError(f"{where}: output {output!r} is also another job's output")
+        outputs.add(output)
+        name = str(job.get("name", os.path.splitext(output)[0]))
         if name in names:
             raise InputError(f"{where}: job name {name!r} used twice")
         names.add(name)
@@ -59,15 +64,49 @@ def load_manifest(path):
         if expect is not None:
             if not isinstance(expect, dict) or "golden" not in expect:
                 raise InputError(f"{where}: expect needs a golden mesh")
+            tol = expect.get("tol", 0.0)
+            if isinstance(tol, bool) or not isinstance(tol, (int, float)) \
+                    or not math.isfinite(tol) or tol < 0:
+                raise InputError(f"{where}: expect: tol must be a finite number >= 0")
             expect = {"golden": os.path.join(base, str(expect["golden"])),
-                      "tol": float(expect.get("tol", 0.0)),
+                      "tol": float(tol),
                       "relative": bool(expect.get("relative", False))}
         jobs.append({"name": name, "mesh": os.path.join(base, str(job["mesh"])),
                      "handles": os.path.join(base, str(job["handles"])),
-                     "output": str(job["output"]), "expect": expect,
+                     "output": output, "expect": expect,
                      "settings": {**defaults, **_settings(where, "settings",
                                                           job.get("settings", {}))}})
     return jobs
+
+
+def _output_name(where, value):
+    """A job's output as a relative path inside the output folder, with a mesh extension."""
+    if not isinstance(value, str) or not value:
+        raise InputError(f"{where}: output must be a file name")
+    norm = os.path.normpath(value)
+    if os.path.isabs(value) or norm == ".." or norm.startswith(".." + os.sep):
+        raise InputError(f"{where}: output {excerpt(value)!r} must stay inside the output "
+                         "folder (-o): no absolute path, no '..'")
+    if os.path.splitext(norm)[1].lower() not in WRITE_FORMATS:
+        raise InputError(f"{where}: output {excerpt(value)!r} needs one of the extensions "
+                         f"{', '.join(WRITE_FORMATS)}")
+    return norm
+
+
+def check_outputs(jobs, out_dir, manifest):
+    """Refuse a run whose outputs (or their sidecars) would land on any job's input or the
+    manifest: a batch must never overwrite what it reads."""
+    inputs = {os.path.realpath(manifest)}
+    for job in jobs:
+        for path in (job["mesh"], job["handles"], *referenced_files(job["handles"]),
+                     *([job["expect"]["golden"]] if job["expect"] else [])):
+            inputs.add(os.path.realpath(path))
+    for job in jobs:
+        out = os.path.realpath(os.path.join(out_dir, job["output"]))
+        for path in (out, out + ".srarap.json"):
+            if path in inputs:
+                raise InputError(f"{manifest}: job {job['name']!r}: output {job['output']!r} "
+                                 "would overwrite one of the batch's inputs")
 
 
 def _settings(where, key, spec):
@@ -116,14 +155,15 @@ def run_job(job, out_dir):
            "seconds": None, "compare_max": None, "message": ""}
     out = os.path.join(out_dir, job["output"])
     sidecar = out + ".srarap.json"
-    key = fingerprint(job)
     try:
+        key = fingerprint(job)
         if os.path.exists(out) and _recorded(sidecar) == key:
             row.update(status="up-to-date", **_recorded_row(sidecar))
         else:
             mesh = read_mesh(job["mesh"])
             constraints = load_handles(job["handles"], mesh.vertices)
-            deformed, result, _ = deform_mesh(mesh, constraints, **job["settings"])
+            deformed, result, _ = deform_mesh(mesh, constraints, name=job["mesh"],
+                                              **job["settings"])
             data, _ = format_mesh(deformed, os.path.splitext(out)[1].lower())
             row.update(status="ok" if result.converged else "not-converged",
                        iterations=result.iterations, energy=result.energy)

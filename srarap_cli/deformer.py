@@ -23,6 +23,7 @@ from .rest_edges import RestEdges
 from .settings import DEFAULTS
 from .starts import STARTS
 from .step import LocalGlobalStep
+from .threads import single_threaded
 
 # the ``accel`` setting names a driver
 ACCEL_DRIVERS = {"anderson": "anderson", "none": "plain"}
@@ -115,6 +116,7 @@ class Deformer:
     (True, True)
     """
 
+    @single_threaded
     def __init__(self, V: ArrayLike, F: ArrayLike, constrained: ArrayLike, *,
                  alpha: float = DEFAULTS["alpha"], feedback: float = DEFAULTS["feedback"],
                  weights: str = DEFAULTS["weights"], area: float | None = None,
@@ -202,6 +204,7 @@ class Deformer:
         """The :class:`~srarap_cli.step.LocalGlobalStep` of one set of targets."""
         return LocalGlobalStep(self, targets, tol)
 
+    @single_threaded
     def solve(self, targets: ArrayLike, *, max_iter: int = DEFAULTS["max_iter"],
               tol: float = DEFAULTS["tol"], time_limit: float | None = DEFAULTS["time_limit"],
               accel: str = DEFAULTS["accel"], start: str = DEFAULTS["start"],

@@ -15,3 +15,16 @@ class NumericalError(RuntimeError):
 
 class SingularSystemError(RuntimeError):
     """A factorization met a singular matrix (for example a part with no constraint)."""
+
+
+def excerpt(text, limit=40):
+    """A short, printable excerpt of user-supplied text for an error message (the file
+    could be anything, a symlinked system file included: quote little of it).
+
+    Examples
+    --------
+    >>> excerpt("root:x:0:0:root:/root:/bin/bash" * 3)
+    'root:x:0:0:root:/root:/bin/bashroot:x...'
+    """
+    text = "".join(c if c.isprintable() else "?" for c in str(text))
+    return text if len(text) <= limit else text[:limit - 3] + "..."

@@ -10,6 +10,27 @@ def solvable_faces(F):
     return F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
 
 
+def geometry_problem(V, F):
+    """Why the triangles F of V cannot be solved in double precision, or None.
+
+    Examples
+    --------
+    >>> geometry_problem(np.array([[0., 0, 0], [1, 0, 0], [2, 0, 0]]), np.array([[0, 1, 2]]))
+    'every triangle has zero area (collinear or coincident vertices)'
+    """
+    F = solvable_faces(np.asarray(F))
+    if not len(F):
+        return "no triangle has three distinct vertices"
+    diag = float(np.linalg.norm(np.ptp(V[np.unique(F)], axis=0)))
+    if not 1e-100 < diag < 1e100:
+        return (f"its vertices span {diag:.3g}: too small or too large to solve in double "
+                "precision; rescale the mesh")
+    area = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    if np.all(area <= 1e-14 * diag * diag):
+        return "every triangle has zero area (collinear or coincident vertices)"
+    return None
+
+
 def unique_rows(a):
     """Distinct rows of an int array (m, k) in lexicographic order, and how often each occurs.
 

@@ -6,8 +6,9 @@ from typing import Any
 import numpy as np
 
 from .deformer import DeformResult
+from .errors import InputError
 from .handles import Constraints
-from .mesh_checks import mesh_warnings, solvable_faces
+from .mesh_checks import geometry_problem, mesh_warnings, solvable_faces
 from .mesh_io import Mesh
 from .oneshot import make_deformer
 from .operators import mesh_area
@@ -48,15 +49,26 @@ class Problem:
         return out
 
 
-def problem(mesh, constraints):
+def problem(mesh, constraints, name="mesh"):
     """Triangulate ``mesh`` (faces that repeat a vertex left out) and cut it down to the
-    region of interest, if there is one."""
+    region of interest, if there is one. ``name`` (the mesh's file) starts error messages.
+
+    Raises
+    ------
+    InputError : no solvable geometry, or a region of interest with nothing free to move
+    """
     V = mesh.vertices
     F = solvable_faces(mesh.triangles()[0])
+    why = geometry_problem(V, F)
+    if why is not None:
+        raise InputError(f"{name}: {why}")
     if constraints.region is None:
         return Problem(np.arange(len(V)), V, F, constraints.ids, constraints.targets,
                        _labels(constraints, constraints.ids))
     sub = restrict(V, F, constraints.ids, constraints.targets, constraints.region)
+    if not len(sub.faces):
+        raise InputError(f"{name}: the region of interest holds no vertex free to move "
+                         "(every vertex in it is constrained)")
     return Problem(sub.vertices, V[sub.vertices], sub.faces, sub.constrained, sub.targets,
                    _labels(constraints, sub.vertices[sub.constrained]), mesh_area(V, F), sub)
 
@@ -87,7 +99,7 @@ def scatter(mesh, p, positions, constraints, constraint_targets=None):
 
 def deform_mesh(mesh: Mesh, constraints: Constraints,
                 callback: Callable[[dict], None] | None = None, cache: str | None = None,
-                **overrides: Any) -> tuple[Mesh, DeformResult, list[str]]:
+                name: str = "mesh", **overrides: Any) -> tuple[Mesh, DeformResult, list[str]]:
     """Deform a :class:`~srarap_cli.mesh_io.Mesh` by its :class:`~srarap_cli.handles.Constraints`.
 
     Parameters
@@ -96,6 +108,7 @@ def deform_mesh(mesh: Mesh, constraints: Constraints,
     constraints : Constraints
     callback : callable(dict), optional, receives each log row
     cache : str, optional, folder for multiresolution coarse meshes
+    name : str, the mesh's file, for error messages
     **overrides : any solver setting (see :mod:`srarap_cli.settings`); None means the
         handle file's value or the default
 
@@ -106,7 +119,7 @@ def deform_mesh(mesh: Mesh, constraints: Constraints,
     warnings : list of str
     """
     opts = resolve(constraints.solver, overrides)
-    p = problem(mesh, constraints)
+    p = problem(mesh, constraints, name)
     deformer = build_deformer(p, opts, cache)
     sub_result = deformer.solve(p.targets, callback=callback, **stage_options(opts, "solve"))
     positions = scatter(mesh, p, sub_result.positions, constraints)

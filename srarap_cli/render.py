@@ -21,6 +21,7 @@ def camera(view):
         d, up = (np.asarray(v, float) for v in VIEWS[view])
     else:
         d = np.array([float(x) for x in view.split(",")])
+        d = d / np.abs(d).max()  # 1e308-sized directions would overflow the norm
         up = np.array([0.0, 0, 1]) if abs(d[2]) < 0.9 * np.linalg.norm(d) else np.array([0.0, 1, 0])
     d = d / np.linalg.norm(d)
     right = np.cross(d, up)

@@ -91,7 +91,15 @@ class Setting:
             kind = click.IntRange(min=self.minimum, min_open=self.strict)
         else:
             kind = click.FloatRange(min=self.minimum, min_open=self.strict)
+            return click.option(self.flag, self.name, type=kind, metavar=self.metavar,
+                                help=text, callback=_finite_option)
         return click.option(self.flag, self.name, type=kind, metavar=self.metavar, help=text)
+
+
+def _finite_option(_ctx, _param, value):
+    if value is not None and not math.isfinite(value):
+        raise click.BadParameter("must be a finite number")
+    return value
 
 
 def _size_option(_ctx, _param, value):

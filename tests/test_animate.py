@@ -141,7 +141,7 @@ def test_time_keys_use_the_frame_rate_and_set_the_frame_count(tmp_path):
 
 def test_output_pattern_needs_a_frame_field(tmp_path):
     r = CliRunner().invoke(main, ["animate", BAR, TWIST, "-o", str(tmp_path / "frame.obj")])
-    assert r.exit_code == 2 and "no field for the frame number" in r.output
+    assert r.exit_code == 2 and "frame-number field" in r.output
 
 
 def test_progress_shows_on_a_terminal_and_stays_quiet_in_a_pipe(tmp_path):

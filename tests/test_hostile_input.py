@@ -151,3 +151,156 @@ def test_aliases_within_bounds_still_work(tmp_path):
                     "  c: {indices: [2], translate: *up}\n")
     c = load_handles(str(path), np.eye(3))
     assert np.allclose(c.targets, np.eye(3) + [[0, 0, 0], [0, 0, 1], [0, 0, 1]])
+
+
+def test_a_non_finite_energy_stops_a_solve_with_a_numerical_error():
+    from types import SimpleNamespace
+
+    from srarap_cli.drivers import Monitor
+    from srarap_cli.errors import NumericalError
+    m = Monitor(max_iter=5, tol=1e-6)
+    with pytest.raises(NumericalError, match="non-finite"):
+        m.record(SimpleNamespace(total=float("nan"), membrane=0.0, bending=0.0,
+                                 positions=np.zeros((2, 3))))
+
+
+HANDLES = ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
+           "  tip: {box: {min: [-2, -2, 5.99], max: [2, 2, 6.01]}, translate: [0, 0, 1]}\n")
+TWO = "groups:\n  a: {indices: [0], fixed: true}\n  b: {indices: [3], translate: [0, 1, 0]}\n"
+FLAT = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\n"
+TINY = "".join(f"v {x * 1e-150} {y * 1e-150} 0\n" for x, y in [(0, 0), (1, 0), (0, 1), (1, 1)])
+
+
+@pytest.mark.parametrize("args, files, code, message", [
+    (["deform", "e.stl", "h.yaml", "-o", "o.obj"], {"e.stl": ""}, 4, "no vertices"),
+    (["deform", "e.stl", "h.yaml", "-o", "o.obj"], {"e.stl": "solid x\nendsolid x\n"}, 4,
+     "no vertices"),
+    (["deform", "b.obj", "h.yaml", "-o", "o.obj"], {"b.obj": "f 1 2 99999999999999999999\n"},
+     4, "out of range"),
+    (["deform", "m.obj", "i.yaml", "-o", "o.obj"],
+     {"i.yaml": "groups:\n  a: {indices: [9223372036854775808], fixed: true}\n"}, 4,
+     "out of range"),
+    (["deform", "m.obj", "h.yaml", "-o", "o.obj", "--alpha", "nan"], {}, 2, "finite"),
+    (["deform", "m.obj", "h.yaml", "-o", "o.obj", "--feedback", "nan"], {}, 2, "finite"),
+    (["deform", "m.obj", "h.yaml", "-o", "o.obj", "--tol", "nan"], {}, 2, "finite"),
+    (["deform", "c.obj", "c.yaml", "-o", "o.obj"], {"c.obj": FLAT, "c.yaml": TWO}, 4,
+     "zero area"),
+    (["deform", "t.obj", "c.yaml", "-o", "o.obj"], {"t.obj": TINY + "f 1 2 3\nf 2 4 3\n",
+                                                   "c.yaml": TWO}, 4, "rescale"),
+    (["deform", "m.obj", "r.yaml", "-o", "o.obj"],
+     {"r.yaml": HANDLES + "region: {indices: [0, 1]}\n"}, 4, "no vertex free to move"),
+    (["batch", "j.yaml", "-o", "bo"], {"j.yaml": "jobs:\n  - {mesh: m.obj, handles: h.yaml, "
+                                       "output: a.obj, expect: {tol: abc, golden: m.obj}}\n"},
+     4, "tol must be a finite number"),
+    (["animate", "m.obj", "h.yaml", "-o", "f_{:>1000000000}.obj", "--frames", "2"], {}, 2,
+     "width at most 99"),
+    (["animate", "m.obj", "h.yaml", "-o", "fr/{}/f.obj", "--frames", "2"], {}, 2,
+     "not in a folder"),
+    (["deform", "m.obj", "h.yaml", "-o", "folder.obj"], {}, 6, "is a folder"),
+    (["deform", "m.obj"], {}, 2, "Missing argument"),
+    (["nosuch"], {}, 2, "No such command"),
+])
+def test_bad_input_is_one_line_with_the_documented_code(tmp_path, args, files, code, message):
+    write_mesh(str(tmp_path / "m.obj"), tube_mesh(rings=3, segments=4))
+    (tmp_path / "h.yaml").write_text(HANDLES)
+    (tmp_path / "folder.obj").mkdir()
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", *args], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == code, p.stderr
+    assert p.stderr.startswith("srarap: error: ") and p.stderr.count("\n") == 1, p.stderr
+    assert message in p.stderr and p.stdout == ""
+    assert not (tmp_path / "o.obj").exists()
+
+
+@pytest.mark.parametrize("output, message", [
+    ("../../x.obj", "must stay inside the output folder"),
+    ("/tmp/elsewhere.obj", "must stay inside the output folder"),
+    ("../jobs.yaml", "must stay inside the output folder"),
+    ("m.obj", "would overwrite one of the batch's inputs"),
+    ("h.yaml.srarap.json.obj", None),
+    ("o.txt", "needs one of the extensions"),
+    ("o", "needs one of the extensions"),
+])
+def test_batch_outputs_stay_inside_their_folder_and_off_the_inputs(tmp_path, output, message):
+    write_mesh(str(tmp_path / "m.obj"), tube_mesh(rings=3, segments=4))
+    (tmp_path / "h.yaml").write_text(HANDLES)
+    manifest = tmp_path / "jobs.yaml"
+    manifest.write_text(f"jobs:\n  - {{mesh: m.obj, handles: h.yaml, output: '{output}'}}\n")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o", "."],
+                       cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    if message is None:
+        assert p.returncode == 0, p.stderr
+        return
+    assert p.returncode == 4 and message in p.stderr and p.stderr.count("\n") == 1
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_two_jobs_with_one_output_are_refused(tmp_path):
+    write_mesh(str(tmp_path / "m.obj"), tube_mesh(rings=3, segments=4))
+    (tmp_path / "h.yaml").write_text(HANDLES)
+    (tmp_path / "jobs.yaml").write_text(
+        "jobs:\n  - {mesh: m.obj, handles: h.yaml, output: a.obj}\n"
+        "  - {mesh: m.obj, handles: h.yaml, output: ./a.obj, name: b}\n")
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o", "out"],
+                       cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 4 and "also another job's output" in p.stderr
+
+
+def test_a_stale_temporary_file_of_a_dead_run_is_swept(tmp_path):
+    from srarap_cli.mesh_io.commit import commit_files
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    stale = tmp_path / f".srarap-{dead}-abcd.tmp"
+    stale.write_bytes(b"x" * 100)
+    mine = tmp_path / f".srarap-{os.getpid()}-live.tmp"  # a live writer's: left alone
+    mine.write_bytes(b"y")
+    commit_files([(str(tmp_path / "out.obj"), b"data")])
+    assert not stale.exists() and mine.exists()
+    assert (tmp_path / "out.obj").read_bytes() == b"data"
+
+
+@pytest.mark.slow
+def test_output_bytes_do_not_depend_on_the_blas_thread_count(tmp_path):
+    from helpers import ROOT
+    outputs = []
+    for threads in ("1", "2"):
+        out = tmp_path / f"o{threads}.obj"
+        env = dict(os.environ, OPENBLAS_NUM_THREADS=threads, OMP_NUM_THREADS=threads)
+        subprocess.run([sys.executable, "-m", "srarap_cli", "deform",
+                        os.path.join(ROOT, "sample_meshes", "spot.obj"),
+                        os.path.join(ROOT, "configs", "spot-nod.yaml"), "-o", str(out), "-q"],
+                       env=env, check=True, timeout=600)
+        outputs.append(out.read_bytes())
+    assert outputs[0] == outputs[1]
+
+
+def test_the_library_solves_with_one_blas_thread():
+    from threadpoolctl import threadpool_info
+
+    from srarap_cli.threads import single_threaded
+    seen = single_threaded(lambda: [i["num_threads"] for i in threadpool_info()
+                                    if i["user_api"] == "blas"])()
+    assert seen and set(seen) == {1}
+
+
+def test_a_job_with_a_hostile_handle_file_fails_alone(tmp_path):
+    write_mesh(str(tmp_path / "m.obj"), tube_mesh(rings=3, segments=4))
+    (tmp_path / "h.yaml").write_text(HANDLES)
+    (tmp_path / "deep.yaml").write_text("groups: " + "[" * 3000 + "]" * 3000 + "\n")
+    (tmp_path / "bomb.yaml").write_text(alias_bomb() + HANDLES.replace("groups", "more"))
+    (tmp_path / "jobs.yaml").write_text(
+        "jobs:\n  - {mesh: m.obj, handles: deep.yaml, output: a.obj}\n"
+        "  - {mesh: m.obj, handles: bomb.yaml, output: b.obj}\n"
+        "  - {mesh: m.obj, handles: h.yaml, output: c.obj}\n")
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o", "out"],
+                       cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert p.returncode == 8, p.stderr
+    import json
+    rows = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert [r["status"] for r in rows] in (["failed", "failed", "ok"],
+                                           ["failed", "failed", "not-converged"])
+    assert "nested too deeply" in rows[0]["message"]
+    assert "expands to more than" in rows[1]["message"]

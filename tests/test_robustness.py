@@ -76,15 +76,15 @@ def test_unreferenced_vertices_and_unconstrained_parts_stay_at_rest(tmp_path, tu
     assert "1 connected part(s) without a constrained vertex" in r.stderr
 
 
-def test_overflowing_coordinates_are_a_numerical_failure_with_no_output(tmp_path, tube):
+def test_coordinates_beyond_double_precision_are_refused_with_no_output(tmp_path, tube):
     V, F = tube
     write_obj(tmp_path / "m.obj", V * 1e160, F)
     groups = {"base": {"indices": [0, 1, 2], "fixed": True},
               "tip": {"indices": [len(V) - 1], "translate": [1e160, 0, 0]}}
     out = tmp_path / "o.obj"
     r = run(tmp_path / "m.obj", handles(tmp_path, groups), "-o", out)
-    assert r.exit_code == 5, r.output
-    assert "no output written" in r.stderr and not out.exists()
+    assert r.exit_code == 4, r.output
+    assert "rescale the mesh" in r.stderr and not out.exists()
 
 
 @pytest.mark.parametrize("text, message", [

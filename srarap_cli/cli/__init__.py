@@ -4,8 +4,12 @@ Subcommand modules are imported only when their command runs, so that ``srarap -
 not load the numerical stack (about a second).
 """
 import importlib
+import sys
 
 import click
+
+from ..threads import pin_process
+from . import signals
 
 #: name -> (module, function, one-line help shown by ``srarap --help``)
 COMMANDS = {
@@ -36,6 +40,31 @@ class LazyGroup(click.Group):
             return None
         module, attr, _ = COMMANDS[name]
         return getattr(importlib.import_module(f".{module}", __name__), attr)
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True,
+             **extra):
+        """Click's main, with its errors as one ``srarap: error:`` line like every other
+        failure (Click prints a usage block first), exit code 2 for bad usage."""
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, False, **extra)
+        signals.install()
+        pin_process()
+        try:
+            code = super().main(args, prog_name, complete_var, False, **extra)
+        except signals.Terminated:  # before a command's own handling took over
+            click.echo("srarap: error: terminated; no output written", err=True)
+            sys.exit(143)
+        except click.UsageError as exc:
+            where = exc.ctx.command_path if exc.ctx is not None else "srarap"
+            click.echo(f"srarap: error: {exc.format_message()} (see '{where} --help')", err=True)
+            sys.exit(exc.exit_code)
+        except click.ClickException as exc:
+            click.echo(f"srarap: error: {exc.format_message()}", err=True)
+            sys.exit(exc.exit_code)
+        except (click.Abort, KeyboardInterrupt):
+            click.echo("srarap: error: interrupted; no output written", err=True)
+            sys.exit(130)
+        sys.exit(code if isinstance(code, int) else 0)
 
     def format_commands(self, ctx, formatter):
         with formatter.section("Commands"):

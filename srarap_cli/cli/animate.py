@@ -1,6 +1,8 @@
 """``srarap animate``: keyframed handles -> one deformed mesh per frame."""
 import math
 import os
+import re
+import string
 import sys
 import time
 
@@ -56,7 +58,7 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, o
     run_id = fingerprint((mesh, handles), opts, n_frames, fps, iters_per_frame, pattern)
     state_path = os.path.join(folder, STATE_NAME)
     state = _resume_state(state_path, run_id) if resume else None
-    animator = Animator(source, constraints, opts, cache=cache)
+    animator = Animator(source, constraints, opts, cache=cache, name=mesh)
     progress = _Progress(n_frames, enabled=not quiet and sys.stderr.isatty())
 
     def write_frame(f, positions, st):
@@ -83,11 +85,25 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, o
                    err=True)
 
 
+def _fields(pattern):
+    """(name, spec, conversion) of each replacement field; a malformed pattern has none."""
+    try:
+        return [(name, spec, conv) for _, name, spec, conv in string.Formatter().parse(pattern)
+                if name is not None]
+    except ValueError:
+        return []
+
+
 def _suffix(pattern):
     return os.path.splitext(pattern.format(0))[1].lower()
 
 
 def _check_pattern(pattern):
+    fields = _fields(pattern)
+    if len(fields) != 1 or fields[0][0] not in ("", "0") or fields[0][2] is not None \
+            or not re.fullmatch(r"0?[1-9]?[0-9]?d?", fields[0][1] or ""):
+        raise click.UsageError(f"-o {pattern!r}: needs exactly one frame-number field such as "
+                               "'{}' or '{:04d}' (width at most 99)")
     try:
         a, b = pattern.format(0), pattern.format(1)
     except (IndexError, KeyError, ValueError):
@@ -95,6 +111,9 @@ def _check_pattern(pattern):
                                "e.g. 'out/frame_{:04d}.obj'") from None
     if a == b:
         raise click.UsageError(f"-o {pattern!r}: has no field for the frame number")
+    if os.path.dirname(a) != os.path.dirname(b):
+        raise click.UsageError(f"-o {pattern!r}: the frame number must be in the file name, "
+                               "not in a folder")
     if _suffix(pattern) not in WRITE_FORMATS:
         raise click.UsageError(f"-o {pattern!r}: extension must be one of "
                                f"{', '.join(WRITE_FORMATS)}")

@@ -7,7 +7,7 @@ import os
 import click
 
 from .. import exit_codes
-from ..batch import SUMMARY_FIELDS, load_manifest, run_batch
+from ..batch import SUMMARY_FIELDS, check_outputs, load_manifest, run_batch
 from ..errors import OutputError
 from ..mesh_io.commit import commit_files
 from .common import guarded
@@ -30,6 +30,7 @@ def batch(manifest, workers, scheduler, out, quiet):
     failed or regressed against its golden mesh.
     """
     jobs = load_manifest(manifest)
+    check_outputs(jobs, out, manifest)
     try:
         os.makedirs(out, exist_ok=True)
     except OSError as exc:

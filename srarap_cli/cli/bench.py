@@ -51,7 +51,7 @@ def bench(mesh, handles, methods, time_budget, out, overrides):
     constraints = load_handles(handles, source.vertices)
     stop = {k: v if overrides[k] is None else overrides[k] for k, v in OWN_DEFAULTS.items()}
     opts = resolve(constraints.solver, {k: v for k, v in overrides.items() if k not in stop})
-    p = problem(source, constraints)
+    p = problem(source, constraints, mesh)
     runs = run_methods(p.V, p.F, p.ids, p.targets, names, settings=opts,
                        time_budget=time_budget, max_iter=stop["max_iter"], tol=stop["tol"],
                        sweeps=opts["sweeps"])

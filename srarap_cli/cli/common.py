@@ -1,9 +1,7 @@
 """What every subcommand shares: error-to-exit-code mapping and output preflight."""
 import functools
 import os
-import signal
 import sys
-import threading
 import traceback
 
 import click
@@ -11,19 +9,14 @@ import numpy as np
 
 from .. import exit_codes
 from ..errors import InputError, NumericalError, OutputError, SingularSystemError
+from ..mesh_io.commit import COMMITTED
+from . import signals
+from .signals import Terminated
 
 
 def fail(code, message):
     click.echo(f"srarap: error: {message}", err=True)
     sys.exit(code)
-
-
-class Terminated(BaseException):
-    """SIGTERM arrived; raised so that cleanup (temporary files) runs on the way out."""
-
-
-def _on_sigterm(_signum, _frame):
-    raise Terminated()
 
 
 def guarded(func):
@@ -32,8 +25,7 @@ def guarded(func):
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
         debug = click.get_current_context().find_root().params.get("debug", False)
-        if threading.current_thread() is threading.main_thread():  # signals: main thread only
-            signal.signal(signal.SIGTERM, _on_sigterm)
+        signals.install()
         try:
             # non-finite results are detected and reported as numerical failures; numpy's own
             # floating-point warnings would only add multi-line noise to stderr
@@ -49,11 +41,20 @@ def guarded(func):
             code, text = _classify(exc)
             fail(code, text)
         except KeyboardInterrupt:
-            fail(exit_codes.INTERRUPTED, "interrupted; no output written")
+            fail(exit_codes.INTERRUPTED, f"interrupted; {_written()}")
         except Terminated:
-            fail(exit_codes.TERMINATED, "terminated; no output written")
+            fail(exit_codes.TERMINATED, f"terminated; {_written()}")
 
     return wrapper
+
+
+def _written():
+    """What the run had committed when a signal stopped it."""
+    if not COMMITTED:
+        return "no output written"
+    names = ", ".join(COMMITTED[:3]) + (f" and {len(COMMITTED) - 3} more" if len(COMMITTED) > 3
+                                        else "")
+    return f"stopped after writing {names}"
 
 
 def _classify(exc):
@@ -63,8 +64,10 @@ def _classify(exc):
         return exit_codes.OUTPUT_ERROR, str(exc)
     if isinstance(exc, NumericalError):
         return exit_codes.NUMERICAL_FAILURE, f"{exc}; no output written"
-    if isinstance(exc, SingularSystemError):
-        return exit_codes.NUMERICAL_FAILURE, f"singular system ({exc}); no output written"
+    if isinstance(exc, SingularSystemError | np.linalg.LinAlgError):
+        return exit_codes.NUMERICAL_FAILURE, (
+            f"singular system ({exc}): degenerate geometry (coincident or collinear vertices, "
+            "zero-area triangles) or a part with no constraint; no output written")
     return exit_codes.INTERNAL_ERROR, (f"internal error: {type(exc).__name__}: {exc} "
                                        "(rerun with --debug for the traceback and report it)")
 

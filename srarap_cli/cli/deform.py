@@ -19,9 +19,9 @@ from .common import cache_option, check_output_path, guarded
 @click.command("deform")
 @click.argument("mesh")
 @click.argument("handles")
-@click.option("-o", "--output", "out", required=True, type=click.Path(dir_okay=False),
+@click.option("-o", "--output", "out", required=True,
               help="Deformed mesh to write: .obj, .ply or .off.")
-@click.option("--log", "log", type=click.Path(dir_okay=False),
+@click.option("--log", "log",
               help="Per-iteration energy log: .csv or .jsonl.")
 @click_options()
 @cache_option
@@ -49,7 +49,8 @@ def deform(mesh, handles, out, log, overrides, cache, preview, write_distortion,
     source = read_mesh(mesh)
     check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
-    deformed, result, notes = deform_mesh(source, constraints, cache=cache, **overrides)
+    deformed, result, notes = deform_mesh(source, constraints, cache=cache, name=mesh,
+                                            **overrides)
     if write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])

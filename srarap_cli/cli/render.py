@@ -63,7 +63,7 @@ def _check_view(view):
         d = np.array([float(x) for x in view.split(",")])
     except ValueError:
         d = np.zeros(0)
-    if d.shape != (3,) or not np.isfinite(d).all() or np.linalg.norm(d) == 0:
+    if d.shape != (3,) or not np.isfinite(d).all() or not np.abs(d).max() > 0:
         raise click.BadParameter(f"{view!r}: a view name ({', '.join(VIEWS)}) or 'x,y,z'",
                                  param_hint="--view")
 

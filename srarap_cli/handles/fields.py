@@ -1,7 +1,10 @@
 """Typed field access for the handle file, with errors that name file, group and field."""
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, excerpt
+
+#: Largest integer a handle file may hold (vertex ids and counts fit in int64 with room).
+MAX_INT = 2 ** 53
 
 
 class Context:
@@ -23,7 +26,7 @@ class Context:
             raise self.error(f"{name} must be a mapping of keys to values")
         unknown = sorted(set(map(str, value)) - set(allowed))
         if unknown:
-            raise self.error(f"unknown key {unknown[0]!r} in {name} "
+            raise self.error(f"unknown key {excerpt(unknown[0])!r} in {name} "
                              f"(allowed: {', '.join(sorted(allowed))})")
         return value
 
@@ -74,4 +77,6 @@ class Context:
             raise self.error(f"{name} must be an integer")
         if minimum is not None and value < minimum:
             raise self.error(f"{name} must be >= {minimum}")
+        if abs(int(value)) > MAX_INT:
+            raise self.error(f"{name}: {int(value)} is out of range")
         return int(value)

@@ -1,8 +1,15 @@
 """Write several output files all-or-nothing: all to temporary names, then all renamed."""
+import glob
 import os
+import signal
 import tempfile
 
 from ..errors import OutputError
+
+#: Paths this process has committed, in order: a signal that arrives after a commit is
+#: reported with what was written, not as "no output written".
+COMMITTED = []
+_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
 def commit_files(files):
@@ -15,8 +22,15 @@ def commit_files(files):
     try:
         for path, data in files:
             staged.append((_stage(path, data), path))
-        for tmp, path in staged:
-            os.replace(tmp, path)
+        # the renames and their record are one critical section: a SIGINT/SIGTERM waits
+        # until both are done, so the report always matches the files on disk
+        blocked = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+        try:
+            for tmp, path in staged:
+                os.replace(tmp, path)
+                COMMITTED.append(path)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
     except OSError as exc:
         raise OutputError(f"{exc.filename or files[0][0]}: cannot write: {exc.strerror}") from None
     finally:
@@ -26,8 +40,9 @@ def commit_files(files):
 
 
 def _stage(path, data):
-    fd, tmp = tempfile.mkstemp(prefix=".srarap-", suffix=".tmp",
-                               dir=os.path.dirname(os.path.abspath(path)))
+    folder = os.path.dirname(os.path.abspath(path))
+    _sweep(folder)
+    fd, tmp = tempfile.mkstemp(prefix=f".srarap-{os.getpid()}-", suffix=".tmp", dir=folder)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -38,3 +53,21 @@ def _stage(path, data):
         os.unlink(tmp)
         raise
     return tmp
+
+
+def _sweep(folder):
+    """Delete temporary files of srarap runs that no longer exist (a SIGKILL during staging
+    leaves one behind); the writer's process id is in the name."""
+    for tmp in glob.glob(os.path.join(glob.escape(folder), ".srarap-*-*.tmp")):
+        try:
+            pid = int(os.path.basename(tmp).split("-")[1])
+            os.kill(pid, 0)
+        except ValueError:
+            continue
+        except ProcessLookupError:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+        except OSError:  # alive but not ours to signal: leave it
+            continue

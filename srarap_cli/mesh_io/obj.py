@@ -5,7 +5,7 @@ per-corner normals, and libigl's reader keeps no polygons of mixed size or other
 """
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, excerpt
 from ..input_files import open_input
 from .mesh import Mesh
 
@@ -26,9 +26,11 @@ def _corner(token, counts, path, lineno):
         try:
             idx = int(part)
         except ValueError:
-            raise InputError(f"{path}:{lineno}: bad face index {token!r}") from None
+            raise InputError(f"{path}:{lineno}: bad face index {excerpt(token, 20)!r}") from None
         if idx == 0:
             raise InputError(f"{path}:{lineno}: face index 0 (OBJ indices start at 1)")
+        if abs(idx) > 2 ** 31:
+            raise InputError(f"{path}:{lineno}: face index {idx} out of range")
         out[k] = idx - 1 if idx > 0 else counts[k] + idx
     return out
 
@@ -78,8 +80,8 @@ def _face_corners(faces, path):
         v = np.array(" ".join(rest for _, rest, _ in faces).split(), dtype=np.int64)
         if v.size and v.min() >= 1:
             return np.column_stack([v - 1, np.full(v.size, -1), np.full(v.size, -1)])
-    except ValueError:
-        pass  # "v/vt/vn" corners or bad tokens: the per-corner parser handles and reports them
+    except (ValueError, OverflowError):
+        pass  # "v/vt/vn" corners, bad or huge tokens: the per-corner parser reports them
     corners = [_corner(t, counts, path, lineno)
                for lineno, rest, counts in faces for t in rest.split()]
     return np.array(corners, dtype=np.int64).reshape(-1, 3)

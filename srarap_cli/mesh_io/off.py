@@ -5,7 +5,7 @@ in the count line) and libigl's triangulates polygons away.
 """
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, excerpt
 from ..input_files import open_input
 from .mesh import Mesh
 
@@ -27,7 +27,7 @@ def read_off(path):
         raise InputError(f"{path}: empty file") from None
     keyword = header[0].upper()
     if not keyword.endswith("OFF"):
-        raise InputError(f"{path}: not an OFF file (first word {header[0]!r})")
+        raise InputError(f"{path}: not an OFF file (first word {excerpt(header[0], 20)!r})")
     prefix = keyword[:-3]
     counts = header[1:] or next(lines, [])
     try:
@@ -45,8 +45,8 @@ def read_off(path):
         sizes = np.array([int(r[0]) for r in frows], dtype=np.int64)
         corners = np.array([int(x) for r, k in zip(frows, sizes) for x in r[1:1 + k]],
                            dtype=np.int64)
-    except ValueError:
-        raise InputError(f"{path}: non-numeric vertex or face entry") from None
+    except (ValueError, OverflowError):
+        raise InputError(f"{path}: non-numeric or out-of-range vertex or face entry") from None
     if corners.size != sizes.sum() or (sizes < 3).any():
         raise InputError(f"{path}: a face line lists fewer indices than its corner count")
     mesh = Mesh(vertices=V, face_sizes=sizes, face_vertices=corners)

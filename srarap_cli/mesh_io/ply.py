@@ -17,7 +17,10 @@ def mesh_from_meshio(m):
     blocks = [c.data for c in m.cells if c.type in ("triangle", "quad", "polygon")]
     sizes = np.concatenate([np.full(len(b), b.shape[1]) for b in blocks]) if blocks else []
     corners = np.concatenate([b.ravel() for b in blocks]) if blocks else []
-    mesh = Mesh(vertices=np.asarray(m.points, dtype=float)[:, :3],
+    points = np.asarray(m.points, dtype=float)
+    if points.ndim != 2 or points.shape[1] < 3:  # an empty or facet-less file
+        points = np.zeros((0, 3))
+    mesh = Mesh(vertices=points[:, :3],
                 face_sizes=np.asarray(sizes, dtype=np.int64),
                 face_vertices=np.asarray(corners, dtype=np.int64))
     data = dict(m.point_data)

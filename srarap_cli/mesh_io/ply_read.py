@@ -7,7 +7,7 @@ with no corners reached libigl and crashed the process.
 """
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, excerpt
 from ..input_files import read_input_bytes
 from .mesh import Mesh
 
@@ -68,7 +68,7 @@ def _header(data, path):
         elif words[0] == "property" and elements:
             elements[-1][2].append(_property(words, path))
         else:
-            raise InputError(f"{path}: bad PLY header line {_short(raw)!r}")
+            raise InputError(f"{path}: bad PLY header line {excerpt(raw)!r}")
     if fmt is None:
         raise InputError(f"{path}: PLY header has no valid 'format' line")
     return fmt, elements, start
@@ -77,21 +77,16 @@ def _header(data, path):
 def _property(words, path):
     if len(words) == 5 and words[1] == "list" and words[2] in _TYPES and words[3] in _TYPES:
         if _TYPES[words[2]][0] == "f":
-            raise InputError(f"{path}: list property {_short(words[4])!r} has a float count")
+            raise InputError(f"{path}: list property {excerpt(words[4])!r} has a float count")
         return words[4], (_TYPES[words[2]], _TYPES[words[3]])
     if len(words) == 3 and words[1] in _TYPES:
         return words[2], _TYPES[words[1]]
-    raise InputError(f"{path}: bad PLY property line {_short(' '.join(words))!r}")
-
-
-def _short(text):
-    text = "".join(c if c.isprintable() else "?" for c in str(text))
-    return text if len(text) <= 40 else text[:37] + "..."
+    raise InputError(f"{path}: bad PLY property line {excerpt(' '.join(words))!r}")
 
 
 def _ascii_element(lines, at, name, count, props, path):
     if at + count > len(lines):
-        raise InputError(f"{path}: element '{_short(name)}' declares {count} lines, the file "
+        raise InputError(f"{path}: element '{excerpt(name)}' declares {count} lines, the file "
                          f"holds {len(lines) - at}")
     rows = [line.split() for line in lines[at:at + count]]
     if not any(isinstance(t, tuple) for _, t in props):
@@ -103,7 +98,7 @@ def _ascii_element(lines, at, name, count, props, path):
         try:
             table = np.array(rows, dtype=float).reshape(count, width)
         except ValueError:
-            raise InputError(f"{path}: element '{_short(name)}' has a non-numeric value") from None
+            raise InputError(f"{path}: element '{excerpt(name)}' has a non-numeric value") from None
         return {p: _cast(table[:, k], t, name, p, path) for k, (p, t) in enumerate(props)}, \
             at + count
     out = {p: [] for p, _ in props}
@@ -132,7 +127,7 @@ def _ascii_element(lines, at, name, count, props, path):
 
 def _cast(column, kind, element, prop, path):
     if kind[0] in "iu" and not np.all(np.isfinite(column) & (column == np.round(column))):
-        raise InputError(f"{path}: {element} property '{_short(prop)}' holds a non-integer")
+        raise InputError(f"{path}: {element} property '{excerpt(prop)}' holds a non-integer")
     return column.astype(kind) if kind[0] in "iu" else column
 
 
@@ -142,7 +137,7 @@ def _ragged(items, kind, element, prop, path):
     try:
         flat = np.array([v for x in items for v in x], dtype=float)
     except ValueError:
-        raise InputError(f"{path}: {element} list '{_short(prop)}' has a non-numeric entry") \
+        raise InputError(f"{path}: {element} list '{excerpt(prop)}' has a non-numeric entry") \
             from None
     return sizes, _cast(flat, kind, element, prop, path)
 
@@ -153,14 +148,14 @@ def _binary_element(body, at, order, name, count, props, path):
         dtype = np.dtype([(p, order + t) for p, t in props])
         need = count * dtype.itemsize
         if at + need > len(body):
-            raise InputError(f"{path}: element '{_short(name)}' declares {count} entries "
+            raise InputError(f"{path}: element '{excerpt(name)}' declares {count} entries "
                              f"({need} bytes), the file holds {len(body) - at} bytes")
         table = np.frombuffer(body, dtype=dtype, count=count, offset=at)
         return {p: table[p].astype(table[p].dtype.newbyteorder("=")) for p, _ in props}, \
             at + need
     least = sum(np.dtype(t[0] if isinstance(t, tuple) else t).itemsize for _, t in props)
     if at + count * least > len(body):
-        raise InputError(f"{path}: element '{_short(name)}' declares {count} entries, the file "
+        raise InputError(f"{path}: element '{excerpt(name)}' declares {count} entries, the file "
                          f"is too short to hold them")
     uniform = _uniform_rows(body, at, order, count, props)
     if uniform is not None:

@@ -10,6 +10,7 @@ from ..errors import NumericalError
 from ..group_rotations import group_rotors
 from ..quaternion import IDENTITY
 from ..settings import DEFAULTS
+from ..threads import single_threaded
 from .cache import coarse_mesh
 from .dirichlet import DirichletSolver
 from .transfer import orient_group_rotors, spread_rotors
@@ -92,6 +93,7 @@ class MultiresDeformer:
     True
     """
 
+    @single_threaded
     def __init__(self, V, F, constrained, labels=None, *, size, cache=None, mode="refine",
                  area=None, **options):
         if mode not in MODES:
@@ -149,6 +151,7 @@ class MultiresDeformer:
         self._row[self._known] = np.arange(self._known.size)
         self.solver = DirichletSolver(self.fine.graph.laplacian, self._known)
 
+    @single_threaded
     def solve(self, targets, *, max_iter=DEFAULTS["max_iter"], tol=DEFAULTS["tol"],
               time_limit=DEFAULTS["time_limit"], accel=DEFAULTS["accel"],
               start=DEFAULTS["start"], initial=None, callback=None):
