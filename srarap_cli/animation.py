@@ -8,11 +8,12 @@ import hashlib
 import io
 import json
 import time
+import zipfile
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InputError
+from .errors import InputError, excerpt
 from .input_files import read_input_bytes
 from .pipeline import build_deformer, problem, scatter
 from .quaternion import align_hemisphere
@@ -43,8 +44,9 @@ class FrameState:
             with np.load(path) as z:
                 return cls(int(z["frame"]), z["positions"], z["rotors"],
                            json.loads(str(z["rows"])), str(z["fingerprint"]))
-        except (OSError, ValueError, KeyError) as exc:
-            raise InputError(f"{path}: unreadable resume state ({exc})") from None
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+            raise InputError(f"{path}: unreadable resume state ({excerpt(exc, 80)}); delete it "
+                             "or run without --resume") from None
 
 
 class Animator:

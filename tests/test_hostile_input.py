@@ -304,3 +304,49 @@ def test_a_job_with_a_hostile_handle_file_fails_alone(tmp_path):
                                            ["failed", "failed", "not-converged"])
     assert "nested too deeply" in rows[0]["message"]
     assert "expands to more than" in rows[1]["message"]
+
+
+@pytest.mark.parametrize("content", [b"", b"PK\x03\x04truncated"])
+def test_an_empty_or_truncated_resume_state_is_invalid_input(tmp_path, content):
+    write_mesh(str(tmp_path / "m.obj"), tube_mesh(rings=3, segments=4))
+    (tmp_path / "h.yaml").write_text(HANDLES)
+    (tmp_path / ".srarap-animate-state.npz").write_bytes(content)
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "animate", "m.obj", "h.yaml", "-o",
+                        "f_{:03d}.obj", "--frames", "2", "--resume"], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 4 and "unreadable resume state" in p.stderr
+    assert p.stderr.count("\n") == 1 and not (tmp_path / "f_000.obj").exists()
+
+
+def test_a_signal_after_the_commit_reports_what_was_written(tmp_path):
+    import click
+    from click.testing import CliRunner
+
+    from srarap_cli.cli.common import guarded
+    from srarap_cli.mesh_io.commit import COMMITTED, commit_files
+
+    @click.command()
+    @guarded
+    def job():
+        commit_files([(str(tmp_path / "a.obj"), b"a")])
+        raise KeyboardInterrupt  # as if SIGINT arrived right after the renames
+
+    del COMMITTED[:]
+    r = CliRunner().invoke(job, [])
+    del COMMITTED[:]
+    assert r.exit_code == 130
+    assert "stopped after writing" in r.output and "a.obj" in r.output
+    assert (tmp_path / "a.obj").read_bytes() == b"a"
+
+
+def test_sigterm_while_still_importing_is_one_line_and_143():
+    code = ("import os, signal, sys\nsys.argv = ['srarap', '--help']\n"
+            "import srarap_cli.entry as e\nsignal.signal(signal.SIGTERM, e._on_sigterm)\n"
+            "import builtins\nreal = builtins.__import__\n"
+            "def slow(name, *a, **k):\n"
+            "    if name == 'click':\n"
+            "        os.kill(os.getpid(), signal.SIGTERM)\n"
+            "    return real(name, *a, **k)\n"
+            "builtins.__import__ = slow\ne.main()\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 143 and p.stderr == "srarap: error: terminated; no output written\n"
