@@ -31,7 +31,7 @@ from .input_files import read_input_bytes
 from .mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from .mesh_io.commit import commit_files
 from .pipeline import deform_mesh
-from .settings import parse_mapping
+from .settings import complete, parse_mapping, resolve
 
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
 SUMMARY_FIELDS = ("job", "status", "iterations", "energy", "seconds", "compare_max", "message")
@@ -158,19 +158,25 @@ def run_job(job, out_dir):
     try:
         key = fingerprint(job)
         if os.path.exists(out) and _recorded(sidecar) == key:
-            row.update(status="up-to-date", **_recorded_row(sidecar))
+            recorded = _recorded_row(sidecar)
+            # an unchanged job that did not converge stays not converged, run after run
+            row.update(recorded, status="up-to-date" if recorded["status"] == "ok" else
+                       recorded["status"])
+            if row["status"] != "up-to-date":
+                row["message"] = "inputs unchanged since the recorded run"
         else:
             mesh = read_mesh(job["mesh"])
             constraints = load_handles(job["handles"], mesh.vertices)
             deformed, result, _ = deform_mesh(mesh, constraints, name=job["mesh"],
                                               **job["settings"])
             data, _ = format_mesh(deformed, os.path.splitext(out)[1].lower())
-            row.update(status="ok" if result.converged else "not-converged",
-                       iterations=result.iterations, energy=result.energy)
+            status = "ok" if complete(result, resolve(constraints.solver, job["settings"])) \
+                else "not-converged"
+            row.update(status=status, iterations=result.iterations, energy=result.energy)
             os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
             commit_files([(out, data), (sidecar, json.dumps(
                 {"fingerprint": key, "iterations": result.iterations,
-                 "energy": result.energy}).encode())])
+                 "energy": result.energy, "status": status}).encode())])
         if job["expect"] is not None:
             _check_golden(row, job["expect"], out)
     except Exception as exc:  # noqa: BLE001 -- a failing job is reported, never fatal
@@ -192,7 +198,9 @@ def _check_golden(row, expect, out):
 def _recorded(sidecar):
     try:
         with open(sidecar) as fh:
-            return json.load(fh).get("fingerprint")
+            rec = json.load(fh)
+        # a record without a status predates status records: run the job again
+        return rec.get("fingerprint") if "status" in rec else None
     except (OSError, ValueError):
         return None
 
@@ -200,7 +208,8 @@ def _recorded(sidecar):
 def _recorded_row(sidecar):
     with open(sidecar) as fh:
         rec = json.load(fh)
-    return {"iterations": rec.get("iterations"), "energy": rec.get("energy")}
+    return {"iterations": rec.get("iterations"), "energy": rec.get("energy"),
+            "status": rec["status"]}
 
 
 def run_batch(jobs, out_dir, workers=1, scheduler=None):

@@ -205,3 +205,9 @@ def click_options(*, exclude=(), defaults=None):
         return wrapper
 
     return decorate
+
+
+def complete(result, opts):
+    """Whether a solve ended as asked: converged, or ``tol`` 0 (no stopping test: run exactly
+    ``max_iter`` iterations) with every iteration run."""
+    return bool(result.converged) or (opts["tol"] == 0 and result.iterations >= opts["max_iter"])

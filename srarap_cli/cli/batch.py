@@ -26,8 +26,9 @@ from .common import guarded
 def batch(manifest, workers, scheduler, out, quiet):
     """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
 
-    Exit code 0 when every job is ok or up to date (or only not converged), 8 when any job
-    failed or regressed against its golden mesh.
+    Exit code 0 when every job is ok or up to date, 8 when any job failed or regressed
+    against its golden mesh, else 3 when any did not converge (recorded: an unchanged job
+    reports it again on every rerun).
     """
     jobs = load_manifest(manifest)
     check_outputs(jobs, out, manifest)
@@ -49,6 +50,8 @@ def batch(manifest, workers, scheduler, out, quiet):
         click.echo(f"srarap batch: {len(rows)} jobs: {summary}{note}", err=True)
     if counts["failed"] or counts["regressed"]:
         raise SystemExit(exit_codes.BATCH_FAILED)
+    if counts["not-converged"]:
+        raise SystemExit(exit_codes.NOT_CONVERGED)
 
 
 def _csv(rows):

@@ -11,7 +11,7 @@ from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
 from ..pipeline import deform_mesh
 from ..preview import preview_png
-from ..settings import click_options, resolve
+from ..settings import click_options, complete, resolve
 from ..solve_log import LOG_FORMATS, format_log
 from .common import cache_option, check_output_path, guarded
 
@@ -28,14 +28,17 @@ from .common import cache_option, check_output_path, guarded
 @click.option("--preview", help="Also write a PNG: rest and deformed shape, handles coloured.")
 @click.option("--write-distortion", is_flag=True,
               help="Add a per-vertex 'distortion' property to PLY output.")
+@click.option("--keep-unconverged", is_flag=True,
+              help="Write the mesh even when the solve did not converge (exit code still 3).")
 @click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
 @guarded
-def deform(mesh, handles, out, log, overrides, cache, preview, write_distortion, quiet):
+def deform(mesh, handles, out, log, overrides, cache, preview, write_distortion,
+           keep_unconverged, quiet):
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
-    Exit codes: 0 converged, 3 not converged within --max-iter (output still written),
-    2 usage, 4 invalid input, 5 numerical failure, 6 output error.
+    Exit codes: 0 converged, 3 not converged (no mesh written unless --keep-unconverged; the
+    log is written), 2 usage, 4 invalid input, 5 numerical failure, 6 output error.
     """
     check_output_path(out, WRITE_FORMATS, "output")
     if preview is not None:
@@ -54,9 +57,11 @@ def deform(mesh, handles, out, log, overrides, cache, preview, write_distortion,
     if write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
+    opts = resolve(constraints.solver, overrides)
+    done = complete(result, opts)
     mesh_bytes, lost = format_mesh(deformed, os.path.splitext(out)[1].lower())
-    files = [(out, mesh_bytes)]
-    if preview is not None:
+    files = [(out, mesh_bytes)] if done or keep_unconverged else []
+    if preview is not None and (done or keep_unconverged):
         files.append((preview, preview_png(deformed, source, constraints, view="iso")))
     if log is not None:
         files.append((log, format_log(result.log, os.path.splitext(log)[1].lower()).encode()))
@@ -66,21 +71,26 @@ def deform(mesh, handles, out, log, overrides, cache, preview, write_distortion,
             click.echo(f"srarap: warning: {note}", err=True)
         for line in result.report_lines():
             click.echo(line, err=True)
-        click.echo(_summary(result, resolve(constraints.solver, overrides), out), err=True)
-    if not result.converged:
+        click.echo(_summary(result, opts, out if files and files[0][0] == out else None),
+                   err=True)
+    if not done:
         raise SystemExit(exit_codes.NOT_CONVERGED)
 
 
 def _summary(result, opts, out):
     last = result.log[-1]
-    state = (f"converged in {result.iterations} iterations" if result.converged else
-             f"NOT converged after {result.iterations} iterations "
-             f"({_why(last, opts)}; {_advice(result, opts)})")
+    if result.converged:
+        state = f"converged in {result.iterations} iterations"
+    elif complete(result, opts):
+        state = f"ran the {result.iterations} iterations asked (tol 0)"
+    else:
+        state = (f"NOT converged after {result.iterations} iterations "
+                 f"({_why(last, opts)}; {_advice(result, opts)})")
     e = result.energies()
     where = f"coarse energy {last['total']:.6g}; full " if result.coarse_log else ""
     return (f"srarap deform: {state}; {where}energy {e['total']:.6g} (membrane "
             f"{e['membrane']:.6g}, bending {e['bending']:.6g}); {result.seconds:.2f} s; "
-            f"wrote {out}")
+            + (f"wrote {out}" if out else "no mesh written (--keep-unconverged writes it)"))
 
 
 

@@ -1,0 +1,80 @@
+"""A failed or unconverged run must not look like a finished one to make, batch or a script."""
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import pytest
+from helpers import ROOT, tube_mesh
+
+from srarap_cli.mesh_io import write_mesh
+
+HANDLES = ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
+           "  tip: {box: {min: [-2, -2, 5.99], max: [2, 2, 6.01]}, rotate: "
+           "{axis: [0, 0, 1], angle: 90}}\n")
+
+
+@pytest.fixture
+def folder(tmp_path):
+    write_mesh(str(tmp_path / "m.obj"), tube_mesh(rings=12, segments=8))
+    (tmp_path / "h.yaml").write_text(HANDLES)
+    return tmp_path
+
+
+@pytest.mark.skipif(shutil.which("make") is None, reason="GNU make is not installed")
+def test_make_fails_on_an_unconverged_run_and_fails_again_on_the_rerun(folder):
+    srarap = f"{sys.executable} -m srarap_cli"
+    (folder / "Makefile").write_text(
+        f"out.obj: m.obj h.yaml\n\t{srarap} deform m.obj h.yaml -o out.obj --max-iter 2 -q\n"
+        f"good.obj: m.obj h.yaml\n\t{srarap} deform m.obj h.yaml -o good.obj -q\n")
+    for _ in range(2):
+        p = subprocess.run(["make", "out.obj"], cwd=folder, capture_output=True, text=True,
+                           timeout=300)
+        assert p.returncode != 0 and not (folder / "out.obj").exists(), p.stdout + p.stderr
+    assert subprocess.run(["make", "good.obj"], cwd=folder, capture_output=True,
+                          timeout=300).returncode == 0
+    again = subprocess.run(["make", "good.obj"], cwd=folder, capture_output=True, text=True,
+                           timeout=300)
+    assert again.returncode == 0 and "up to date" in again.stdout
+
+
+def test_keep_unconverged_writes_the_mesh_and_still_exits_3(folder):
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "m.obj", "h.yaml", "-o",
+                        "o.obj", "--max-iter", "2", "--log", "o.csv", "--keep-unconverged"],
+                       cwd=folder, capture_output=True, text=True, timeout=300)
+    assert p.returncode == 3 and (folder / "o.obj").exists() and (folder / "o.csv").exists()
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "m.obj", "h.yaml", "-o",
+                        "p.obj", "--max-iter", "2", "--log", "p.csv"],
+                       cwd=folder, capture_output=True, text=True, timeout=300)
+    assert p.returncode == 3 and not (folder / "p.obj").exists() and (folder / "p.csv").exists()
+    assert "no mesh written" in p.stderr and "raise --max-iter" in p.stderr
+
+
+def batch(folder, settings):
+    (folder / "jobs.yaml").write_text(
+        f"jobs:\n  - {{mesh: m.obj, handles: h.yaml, output: a.obj, settings: {settings}}}\n")
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o", "out"],
+                       cwd=folder, capture_output=True, text=True, timeout=300)
+    rows = json.loads((folder / "out" / "summary.json").read_text())
+    return p.returncode, rows[0]["status"]
+
+
+def test_batch_remembers_a_job_that_did_not_converge(folder):
+    assert batch(folder, "{max_iter: 2}") == (3, "not-converged")
+    assert batch(folder, "{max_iter: 2}") == (3, "not-converged")  # nothing changed
+    assert batch(folder, "{max_iter: 1000}") == (0, "ok")  # settings changed: run again
+    assert batch(folder, "{max_iter: 1000}") == (0, "up-to-date")
+
+
+def test_the_readme_batch_example_is_the_shipped_file_and_passes_as_written(tmp_path):
+    readme = open(os.path.join(ROOT, "README.md"), encoding="utf-8").read()
+    block = re.search(r"```yaml\n(# configs/example-jobs.yaml.*?)```", readme, re.S).group(1)
+    path = os.path.join(ROOT, "configs", "example-jobs.yaml")
+    assert open(path, encoding="utf-8").read() == block
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "batch", path, "-o",
+                        str(tmp_path)], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    rows = json.loads((tmp_path / "summary.json").read_text())
+    assert [r["status"] for r in rows] == ["ok"] * len(rows)
