@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.sparse import csgraph
 
+from . import api_checks
 from .drivers import DRIVERS, Monitor
 from .energy import bending_energy, membrane_energy
 from .global_step import PoissonSolver
@@ -128,15 +129,14 @@ class Deformer:
             raise ValueError("alpha must be > 0")
         if not feedback >= 0:
             raise ValueError("feedback must be >= 0")
-        self.V = np.asarray(V, dtype=float)
-        self.F = np.asarray(F, dtype=np.int64)
+        self.V, self.F = api_checks.mesh_arrays(V, F)
         self.weights = weights
         self.graph = cell_graph(self.V, self.F, weights)
         self.alpha = float(alpha)
         self.feedback = float(feedback)
         self.area = self.graph.area if area is None else float(area)
         self.method, self.sweeps = method, sweeps
-        self.constrained = np.asarray(constrained, dtype=np.int64).ravel()
+        self.constrained = api_checks.vertex_ids(constrained, len(self.V))
         self._mask = np.zeros(len(self.V), dtype=bool)
         self._mask[self.constrained] = True
         self.warnings = weight_warnings(self.graph)
@@ -232,6 +232,7 @@ class Deformer:
         -------
         DeformResult
         """
+        targets = api_checks.targets(targets, len(self.constrained))
         self.prepare()
         monitor = Monitor(max_iter=max_iter, tol=tol, time_limit=time_limit,
                           callback=callback, energy_floor=self.energy_floor,
@@ -257,9 +258,12 @@ def unanchored(graph, constrained):
     anchored[label[constrained]] = True
     lonely = np.flatnonzero((graph.degree == 0) & ~constrained)
     floating = np.flatnonzero(~anchored[label] & (graph.degree > 0))
+    placed = int(np.sum((graph.degree == 0) & constrained))
     notes = []
-    if lonely.size:
-        notes.append(f"{lonely.size} unreferenced vertices kept at rest")
+    if lonely.size or placed:
+        notes.append(f"{lonely.size + placed} unreferenced vertices (in no triangle): "
+                     f"{lonely.size} kept at rest, {placed} constrained ones placed at their "
+                     "targets")
     if floating.size:
         parts = np.unique(label[floating]).size
         notes.append(f"{parts} connected part(s) without a constrained vertex "

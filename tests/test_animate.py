@@ -90,16 +90,24 @@ def test_sequence_is_deterministic_and_resume_after_a_kill_gives_the_same_files(
     assert all((ref / n).read_bytes() == (tmp_path / "again" / n).read_bytes() for n in names)
 
     proc = subprocess.Popen(base + ["-o", str(cut / "f_{:03d}.obj"), "--log",
-                                    str(tmp_path / "cut.csv")])
+                                    str(tmp_path / "cut.csv")], stderr=subprocess.PIPE,
+                            text=True)
     deadline = time.time() + 60
     while not (cut / "f_010.obj").exists() and time.time() < deadline:
         time.sleep(0.05)
     proc.send_signal(signal.SIGTERM)
     assert proc.wait(timeout=60) == 143
+    said = proc.stderr.read()
     done = [n for n in os.listdir(cut) if n.endswith(".obj")]
     assert 10 < len(done) < 48
-    subprocess.run(base + ["-o", str(cut / "f_{:03d}.obj"), "--log", str(tmp_path / "cut.csv"),
-                           "--resume"], check=True)
+    # the message tells what was kept and that the run can be resumed
+    assert f"stopped after writing {len(done)} files" in said and "--resume" in said, said
+    resumed = subprocess.run([b for b in base if b != "-q"]
+                             + ["-o", str(cut / "f_{:03d}.obj"), "--log",
+                                str(tmp_path / "cut.csv"), "--resume"],
+                             check=True, stderr=subprocess.PIPE, text=True).stderr
+    assert f"wrote {cut / 'f_{:03d}.obj'}".format(len(done)) in resumed, resumed
+    assert f"(frames 0-{len(done) - 1} were kept from the interrupted run)" in resumed
     assert sorted(os.listdir(cut)) == names  # all frames, no state or temporary file left
     assert all((ref / n).read_bytes() == (cut / n).read_bytes() for n in names)
     with open(tmp_path / "cut.csv") as a, open(tmp_path / "ref.csv") as b:

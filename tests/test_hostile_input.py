@@ -350,3 +350,21 @@ def test_sigterm_while_still_importing_is_one_line_and_143():
             "builtins.__import__ = slow\ne.main()\n")
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert p.returncode == 143 and p.stderr == "srarap: error: terminated; no output written\n"
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda V, F: dict(targets=np.zeros((3, 2))), r"targets must be a \(2, 3\) array"),
+    (lambda V, F: dict(targets=[[0, 0, np.nan], [0, 0, 0]]), "targets has NaN"),
+    (lambda V, F: dict(V=V[:, :2]), r"V must be an \(n, 3\) array"),
+    (lambda V, F: dict(F=F + len(V)), "F: vertex index"),
+    (lambda V, F: dict(constrained=[0, 0]), "lists a vertex twice"),
+    (lambda V, F: dict(constrained=[0.5, 1]), "integer vertex indices"),
+])
+def test_the_api_names_the_bad_argument_and_its_shape(make, message):
+    from srarap_cli import deform
+    from srarap_cli.multires.simplify import _octahedron
+    V, F = _octahedron()
+    args = dict(V=V, F=F, constrained=[0, 1], targets=V[[0, 1]])
+    args.update(make(V, F))
+    with pytest.raises(ValueError, match=message):
+        deform(args["V"], args["F"], args["constrained"], args["targets"], max_iter=2)

@@ -72,8 +72,22 @@ def test_unreferenced_vertices_and_unconstrained_parts_stay_at_rest(tmp_path, tu
     assert r.exit_code == 0, r.output
     out = read_mesh(str(tmp_path / "o.obj")).vertices
     assert np.array_equal(out[len(V):], V2[len(V):])
-    assert "1 unreferenced vertices kept at rest" in r.stderr
+    assert "1 unreferenced vertices (in no triangle): 1 kept at rest, 0 constrained" in r.stderr
     assert "1 connected part(s) without a constrained vertex" in r.stderr
+
+
+def test_the_unreferenced_warning_counts_those_in_handle_groups_too(tmp_path, tube):
+    V, F = tube
+    V2 = np.vstack([V, [[0.0, 0, 6.0], [50.0, 50, 50]]])  # one in the tip box, one far away
+    write_obj(tmp_path / "m.obj", V2, F)
+    groups = {"base": BASE, "tip": {"box": {"min": [-2, -2, 5.99], "max": [2, 2, 6.01]},
+                                    "translate": [1.0, 0, 0]}}
+    r = run(tmp_path / "m.obj", handles(tmp_path, groups), "-o", tmp_path / "o.obj")
+    assert r.exit_code == 0, r.output
+    assert "2 unreferenced vertices (in no triangle): 1 kept at rest, 1 constrained ones " \
+        "placed at their targets" in r.stderr
+    out = read_mesh(str(tmp_path / "o.obj")).vertices
+    assert np.allclose(out[len(V)], [1.0, 0, 6.0]) and np.array_equal(out[-1], V2[-1])
 
 
 def test_coordinates_beyond_double_precision_are_refused_with_no_output(tmp_path, tube):

@@ -79,10 +79,14 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, o
             click.echo(line, err=True)
         stalled = sum(not r["converged"] for r in rows)
         seconds = sum(r["seconds"] for r in rows)
+        first = 0 if state is None else state.frame + 1
+        wrote = (f"wrote {pattern.format(first)} .. {pattern.format(n_frames - 1)}"
+                 if first < n_frames else "nothing left to write")
+        if first:
+            wrote += f" (frames 0-{first - 1} were kept from the interrupted run)"
         click.echo(f"srarap animate: {len(rows)} frames ({stalled} stopped at "
                    f"--iters-per-frame {iters_per_frame}); {len(rows) / max(seconds, 1e-9):.2f} "
-                   f"frames/s; wrote {pattern.format(0)} .. {pattern.format(n_frames - 1)}",
-                   err=True)
+                   f"frames/s; {wrote}", err=True)
 
 
 def _fields(pattern):

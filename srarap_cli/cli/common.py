@@ -49,12 +49,17 @@ def guarded(func):
 
 
 def _written():
-    """What the run had committed when a signal stopped it."""
-    if not COMMITTED:
+    """What the run had committed when a signal stopped it (an animation's resume state is
+    not named, but said to be there)."""
+    files = list(dict.fromkeys(p for p in COMMITTED
+                               if not os.path.basename(p).startswith(".srarap-")))
+    if not files:
         return "no output written"
-    names = ", ".join(COMMITTED[:3]) + (f" and {len(COMMITTED) - 3} more" if len(COMMITTED) > 3
-                                        else "")
-    return f"stopped after writing {names}"
+    text = (f"stopped after writing {files[0]}" if len(files) == 1 else
+            f"stopped after writing {len(files)} files ({files[0]} .. {files[-1]}), kept")
+    if len(files) < len(set(COMMITTED)):
+        text += "; run it again with --resume to continue"
+    return text
 
 
 def _classify(exc):

@@ -5,6 +5,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import api_checks
 from ..deformer import Deformer, DeformResult
 from ..errors import NumericalError
 from ..group_rotations import group_rotors
@@ -100,9 +101,8 @@ class MultiresDeformer:
             raise ValueError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
         self.mode = mode
         start = time.perf_counter()
-        self.V = np.asarray(V, dtype=float)
-        self.F = np.asarray(F, dtype=np.int64)
-        self.constrained = np.asarray(constrained, dtype=np.int64).ravel()
+        self.V, self.F = api_checks.mesh_arrays(V, F)
+        self.constrained = api_checks.vertex_ids(constrained, len(self.V))
         k = self.constrained.size
         self.labels = np.zeros(k, np.int64) if labels is None else np.asarray(labels, np.int64)
         self.n_groups = int(self.labels.max(initial=-1)) + 1
@@ -158,7 +158,7 @@ class MultiresDeformer:
         """Deform toward ``targets``; see :meth:`Deformer.solve` (``max_iter`` and
         ``time_limit`` hold for each level). Returns a :class:`MultiresResult`."""
         begin = time.perf_counter()
-        targets = np.asarray(targets, dtype=float).reshape(-1, 3)
+        targets = api_checks.targets(targets, len(self.constrained))
         cv = self.coarse.vertices
         warm = None if initial is None else (np.asarray(initial[0])[cv],
                                               np.asarray(initial[1])[cv])
