@@ -78,3 +78,47 @@ def test_the_readme_batch_example_is_the_shipped_file_and_passes_as_written(tmp_
     assert p.returncode == 0, p.stderr
     rows = json.loads((tmp_path / "summary.json").read_text())
     assert [r["status"] for r in rows] == ["ok"] * len(rows)
+
+
+def test_standard_input_and_output_with_formats(folder):
+    ref = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "m.obj", "h.yaml", "-o",
+                          "ref.obj", "-q"], cwd=folder, capture_output=True, timeout=300)
+    assert ref.returncode == 0
+    with open(folder / "m.obj", "rb") as fh:
+        p = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "-", "h.yaml", "-o",
+                            "-", "--format", "obj", "--input-format", "obj"], cwd=folder,
+                           stdin=fh, capture_output=True, timeout=300)
+    assert p.returncode == 0 and p.stdout == (folder / "ref.obj").read_bytes()
+    assert b"wrote <stdout>" in p.stderr
+    for args, code in ((["--input-format", "ply"], 4), ([], 2)):
+        bad = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "-", "h.yaml", "-o",
+                              "-", "--format", "ply", *args], cwd=folder, input=b"garbage",
+                             capture_output=True, timeout=300)
+        assert bad.returncode == code and bad.stdout == b"" and bad.stderr.count(b"\n") == 1
+
+
+@pytest.mark.slow
+def test_a_long_deform_shows_progress_on_a_terminal_only(tmp_path):
+    import pty
+    import select
+    spot = os.path.join(ROOT, "sample_meshes", "spot.obj")
+    nod = os.path.join(ROOT, "configs", "spot-nod.yaml")
+    cmd = [sys.executable, "-m", "srarap_cli", "deform", spot, nod, "-o", str(tmp_path / "o.obj"),
+           "--accel", "none", "--start", "laplacian", "--tol", "0", "--max-iter", "150"]
+    master, slave = pty.openpty()
+    subprocess.run(cmd, stderr=slave, stdout=subprocess.DEVNULL, check=True, timeout=600)
+    os.close(slave)
+    seen = b""
+    while select.select([master], [], [], 0.5)[0]:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:
+            break
+        if not chunk:
+            break
+        seen += chunk
+    os.close(master)
+    text = seen.decode(errors="replace")
+    assert "\riteration " in text and "energy " in text and "change " in text
+    piped = subprocess.run(cmd, capture_output=True, text=True, check=True, timeout=600)
+    assert "\riteration" not in piped.stderr and "srarap deform:" in piped.stderr

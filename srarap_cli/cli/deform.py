@@ -1,10 +1,13 @@
 """``srarap deform``: mesh + handle file -> deformed mesh + energy log."""
 import os
+import sys
+import tempfile
 
 import click
 
 from .. import exit_codes
 from ..distortion import vertex_distortion
+from ..errors import InputError
 from ..handles import load_handles
 from ..limits import check_solve
 from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
@@ -14,13 +17,19 @@ from ..preview import preview_png
 from ..settings import click_options, complete, resolve
 from ..solve_log import LOG_FORMATS, format_log
 from .common import cache_option, check_output_path, guarded
+from .progress import SolveProgress
 
 
 @click.command("deform")
 @click.argument("mesh")
 @click.argument("handles")
 @click.option("-o", "--output", "out", required=True,
-              help="Deformed mesh to write: .obj, .ply or .off.")
+              help="Deformed mesh to write: .obj, .ply or .off; '-' for standard output "
+                   "(with --format).")
+@click.option("--input-format", type=click.Choice(["obj", "off", "ply", "stl"]),
+              help="Format of MESH when it is '-' (standard input).")
+@click.option("--format", "out_format", type=click.Choice(["obj", "off", "ply"]),
+              help="Format of the output when it is '-' (standard output).")
 @click.option("--log", "log",
               help="Per-iteration energy log: .csv or .jsonl.")
 @click_options()
@@ -32,49 +41,85 @@ from .common import cache_option, check_output_path, guarded
               help="Write the mesh even when the solve did not converge (exit code still 3).")
 @click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
 @guarded
-def deform(mesh, handles, out, log, overrides, cache, preview, write_distortion,
-           keep_unconverged, quiet):
+def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, preview,
+           write_distortion, keep_unconverged, quiet):
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
     Exit codes: 0 converged, 3 not converged (no mesh written unless --keep-unconverged; the
     log is written), 2 usage, 4 invalid input, 5 numerical failure, 6 output error.
     """
-    check_output_path(out, WRITE_FORMATS, "output")
+    suffix = _output_suffix(out, out_format)
+    if out != "-":
+        check_output_path(out, WRITE_FORMATS, "output")
     if preview is not None:
         check_output_path(preview, (".png",), "preview")
-    if write_distortion and not out.lower().endswith(".ply"):
+    if write_distortion and suffix != ".ply":
         raise click.UsageError("--write-distortion needs a .ply output")
     if log is not None:
         check_output_path(log, LOG_FORMATS, "log")
         if os.path.abspath(log) == os.path.abspath(out):
             raise click.UsageError("--log and --output name the same file")
-    source = read_mesh(mesh)
-    check_solve(mesh, len(source.vertices))
+    source = read_stdin_mesh(input_format) if mesh == "-" else read_mesh(mesh)
+    name = "<stdin>" if mesh == "-" else mesh
+    check_solve(name, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
-    deformed, result, notes = deform_mesh(source, constraints, cache=cache, name=mesh,
-                                            **overrides)
+    progress = SolveProgress(enabled=not quiet and sys.stderr.isatty())
+    try:
+        deformed, result, notes = deform_mesh(source, constraints, callback=progress,
+                                              cache=cache, name=name, **overrides)
+    finally:
+        progress.close()
     if write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
     opts = resolve(constraints.solver, overrides)
     done = complete(result, opts)
-    mesh_bytes, lost = format_mesh(deformed, os.path.splitext(out)[1].lower())
-    files = [(out, mesh_bytes)] if done or keep_unconverged else []
-    if preview is not None and (done or keep_unconverged):
+    mesh_bytes, lost = format_mesh(deformed, suffix)
+    keep = done or keep_unconverged
+    files = [(out, mesh_bytes)] if keep and out != "-" else []
+    if preview is not None and keep:
         files.append((preview, preview_png(deformed, source, constraints, view="iso")))
     if log is not None:
         files.append((log, format_log(result.log, os.path.splitext(log)[1].lower()).encode()))
     commit_files(files)
+    if keep and out == "-":
+        sys.stdout.buffer.write(mesh_bytes)
+        sys.stdout.flush()
     if not quiet:
         for note in notes + lost:
             click.echo(f"srarap: warning: {note}", err=True)
         for line in result.report_lines():
             click.echo(line, err=True)
-        click.echo(_summary(result, opts, out if files and files[0][0] == out else None),
-                   err=True)
+        shown = "<stdout>" if out == "-" else out
+        click.echo(_summary(result, opts, shown if keep else None), err=True)
     if not done:
         raise SystemExit(exit_codes.NOT_CONVERGED)
+
+
+def _output_suffix(out, out_format):
+    if out == "-":
+        if out_format is None:
+            raise click.UsageError("-o - (standard output) needs --format obj|off|ply")
+        return "." + out_format
+    if out_format is not None and os.path.splitext(out)[1].lower() != "." + out_format:
+        raise click.UsageError(f"--format {out_format} does not match the output {out!r}")
+    return os.path.splitext(out)[1].lower()
+
+
+def read_stdin_mesh(input_format):
+    """The mesh on standard input, parsed by the reader of ``input_format``."""
+    if input_format is None:
+        raise click.UsageError("MESH '-' (standard input) needs --input-format obj|off|ply|stl")
+    data = sys.stdin.buffer.read()
+    with tempfile.TemporaryDirectory(prefix="srarap-stdin-") as folder:
+        path = os.path.join(folder, "stdin." + input_format)
+        with open(path, "wb") as fh:
+            fh.write(data)
+        try:
+            return read_mesh(path)
+        except InputError as exc:
+            raise InputError(str(exc).replace(path, "<stdin>")) from None
 
 
 def _summary(result, opts, out):
