@@ -1,11 +1,24 @@
 """A picture of a deformed mesh: rest and deformed shape, handles coloured or strain mapped."""
+import numpy as np
+
 from .distortion import vertex_distortion
 from .render import face_colors, render_png
 
+#: Proper rotations taking each axis name to +z, the renderer's up.
+UP = {"z": np.eye(3), "-z": np.diag([1.0, -1, -1]),
+      "y": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]),
+      "-y": np.array([[1.0, 0, 0], [0, 0, 1], [0, -1, 0]]),
+      "x": np.array([[0.0, 0, -1], [0, 1, 0], [1, 0, 0]]),
+      "-x": np.array([[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]])}
 
-def preview_png(mesh, rest=None, constraints=None, color="shade", layout="side", view="iso",
-                size=(800, 600)):
-    """PNG bytes of ``mesh`` (and its ``rest`` shape), handles coloured or distortion mapped."""
+
+def preview_png(mesh, rest=None, constraints=None, color="shade", layout="ghost", view="iso",
+                size=(800, 600), up="y"):
+    """PNG bytes of ``mesh`` (and its ``rest`` shape), handles coloured or distortion mapped;
+    ``up`` names the mesh's axis drawn upward (OBJ's convention, y, by default)."""
+    turn = UP[up].T
+    mesh = mesh.with_vertices(mesh.vertices @ turn)
+    rest = None if rest is None else rest.with_vertices(rest.vertices @ turn)
     F = mesh.triangles()[0]
     groups = list(constraints.groups.values()) if constraints is not None else None
     colorbar = None

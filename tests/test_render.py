@@ -29,7 +29,7 @@ def near(img, rgb, tol=0.12):
 def test_render_has_the_size_asked_and_colours_handles_where_they_project(tmp_path):
     out = tmp_path / "p.png"
     r = invoke("render", BAR, "--handles", BEND, "--view", "front", "--size", "300x600",
-               "-o", out)
+               "--up", "z", "-o", out)
     assert r.exit_code == 0, r.output
     img = imread(str(out))
     assert img.shape[:2] == (600, 300)
@@ -93,3 +93,22 @@ def test_several_views_are_drawn_side_by_side(tmp_path):
     # from the top the tip cap (blue) covers the bar's disc; from the front only a band
     blue = near(img, PALETTE[1], 0.35)
     assert blue[:, 300:].sum() > 3 * blue[:, :300].sum()
+
+
+@pytest.mark.parametrize("up, tall", [("y", True), ("z", False), ("-y", True), ("x", False)])
+def test_the_up_axis_is_drawn_upward(tmp_path, up, tall):
+    # a box 1 x 4 x 1: tall on screen exactly when its long axis (y) is the one drawn upward
+    V = np.array([[x, y, z] for x in (0, 1) for y in (0, 4) for z in (0, 1)], dtype=float)
+    F = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    path = tmp_path / "box.obj"
+    path.write_text("".join(f"v {a} {b} {c}\n" for a, b, c in V)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F))
+    out = tmp_path / "p.png"
+    assert invoke("render", path, "--view", "front", "--up", up, "--size", "400x400",
+                  "-o", out).exit_code == 0
+    img = imread(str(out))[..., :3]
+    ink = np.flatnonzero((img < 0.95).any(axis=2).any(axis=1)), \
+        np.flatnonzero((img < 0.95).any(axis=2).any(axis=0))
+    height, width = np.ptp(ink[0]), np.ptp(ink[1])
+    assert (height > 2 * width) == tall  # otherwise the long axis points at the camera

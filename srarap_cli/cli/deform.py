@@ -35,6 +35,8 @@ from .progress import SolveProgress
 @click_options()
 @cache_option
 @click.option("--preview", help="Also write a PNG: rest and deformed shape, handles coloured.")
+@click.option("--preview-up", type=click.Choice(["y", "z", "x", "-y", "-z", "-x"]), default="y",
+              show_default=True, help="The mesh's axis drawn upward in --preview.")
 @click.option("--write-distortion", is_flag=True,
               help="Add a per-vertex 'distortion' property to PLY output.")
 @click.option("--keep-unconverged", is_flag=True,
@@ -42,7 +44,7 @@ from .progress import SolveProgress
 @click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
 @guarded
 def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, preview,
-           write_distortion, keep_unconverged, quiet):
+           preview_up, write_distortion, keep_unconverged, quiet):
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
@@ -79,7 +81,8 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
     keep = done or keep_unconverged
     files = [(out, mesh_bytes)] if keep and out != "-" else []
     if preview is not None and keep:
-        files.append((preview, preview_png(deformed, source, constraints, view="iso")))
+        files.append((preview, preview_png(deformed, source, constraints, view="iso",
+                                                  up=preview_up)))
     if log is not None:
         files.append((log, format_log(result.log, os.path.splitext(log)[1].lower()).encode()))
     commit_files(files)

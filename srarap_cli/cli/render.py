@@ -32,14 +32,19 @@ def parse_size(text):
               "for --color distortion.")
 @click.option("--color", type=click.Choice(["shade", "distortion"]), default="shade",
               show_default=True)
-@click.option("--layout", type=click.Choice(["side", "ghost"]), default="side", show_default=True,
-              help="Rest shape beside the mesh, or ghosted behind it.")
+@click.option("--layout", type=click.Choice(["ghost", "side"]), default="ghost",
+              show_default=True,
+              help="Rest shape ghosted behind the mesh (small deformations show), or beside it.")
+@click.option("--up", type=click.Choice(["y", "z", "x", "-y", "-z", "-x"]), default="y",
+              show_default=True,
+              help="The mesh's axis drawn upward: y for most OBJ/PLY files (and the samples), "
+                   "z for CAD and scanner data.")
 @click.option("--view", "views", multiple=True, default=("iso",), show_default=True,
               help=f"{', '.join(VIEWS)}, or a viewing direction 'x,y,z'; repeat for "
                    "several views side by side.")
 @click.option("--size", default="800x600", show_default=True, help="WIDTHxHEIGHT in pixels.")
 @guarded
-def render(mesh, out, handles, rest, color, layout, views, size):
+def render(mesh, out, handles, rest, color, layout, up, views, size):
     """Render MESH to a PNG, headless."""
     check_output_path(out, (".png",), "output")
     size = parse_size(size)
@@ -53,7 +58,7 @@ def render(mesh, out, handles, rest, color, layout, views, size):
         raise click.UsageError("--color distortion needs --rest")
     constraints = load_handles(handles, (base or shown).vertices) if handles else None
     commit_files([(out, preview_png(shown, base, constraints, color, layout, list(views),
-                                    size))])
+                                    size, up))])
 
 
 def _check_view(view):
