@@ -154,6 +154,9 @@ def _advice(result, opts):
     if opts["time_limit"] is not None and result.seconds >= opts["time_limit"]:
         return f"stopped by --time-limit {opts['time_limit']:g}: allow more time"
     tips = [f"raise --max-iter (was {opts['max_iter']})"]
+    n = len(result.positions)
+    if opts["multires"] == "off" and n > 100_000:
+        tips.append(f"--multires auto (a coarse solve starts the {n} vertices closer)")
     if opts["accel"] == "none":
         tips.append("use --accel anderson")
     if opts["start"] == "laplacian":
