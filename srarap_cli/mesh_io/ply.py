@@ -7,33 +7,20 @@ import numpy as np
 
 from .mesh import Mesh
 
-_UV_NAMES = (("s", "t"), ("u", "v"), ("texture_u", "texture_v"))
 _PLY_TYPES = {"u1": "uchar", "i1": "char", "u2": "ushort", "i2": "short", "u4": "uint",
               "i4": "int", "f4": "float", "f8": "double"}
 
 
 def mesh_from_meshio(m):
-    """Convert a ``meshio.Mesh`` to :class:`Mesh`, polygon blocks kept in file order."""
+    """Convert a ``meshio.Mesh`` read from an STL file to :class:`Mesh` (triangles only)."""
     blocks = [c.data for c in m.cells if c.type in ("triangle", "quad", "polygon")]
     sizes = np.concatenate([np.full(len(b), b.shape[1]) for b in blocks]) if blocks else []
     corners = np.concatenate([b.ravel() for b in blocks]) if blocks else []
     points = np.asarray(m.points, dtype=float)
     if points.ndim != 2 or points.shape[1] < 3:  # an empty or facet-less file
         points = np.zeros((0, 3))
-    mesh = Mesh(vertices=points[:, :3],
-                face_sizes=np.asarray(sizes, dtype=np.int64),
+    return Mesh(vertices=points[:, :3], face_sizes=np.asarray(sizes, dtype=np.int64),
                 face_vertices=np.asarray(corners, dtype=np.int64))
-    data = dict(m.point_data)
-    if all(k in data for k in ("nx", "ny", "nz")):
-        mesh.normals = np.column_stack([data.pop(k) for k in ("nx", "ny", "nz")]).astype(float)
-        mesh.face_normals = mesh.face_vertices.copy()
-    for a, b in _UV_NAMES:
-        if a in data and b in data:
-            mesh.uv = np.column_stack([data.pop(a), data.pop(b)]).astype(float)
-            mesh.face_uv = mesh.face_vertices.copy()
-            break
-    mesh.vertex_data = {k: np.asarray(v) for k, v in data.items() if np.ndim(v) == 1}
-    return mesh
 
 
 def per_vertex(mesh, values, refs):
