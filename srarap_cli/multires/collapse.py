@@ -28,7 +28,7 @@ MIN_NORMAL_COS = 0.17
 #: (1 for an equilateral one) is under this and under the worst of the triangles it replaces.
 MIN_QUALITY = 0.3
 #: Selection passes per round (each adds collapses away from those already chosen).
-PASSES = 16
+PASSES = 8
 
 
 def collapse_to(V, F, size, frozen):
