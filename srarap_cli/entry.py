@@ -4,26 +4,19 @@ Installed before anything is imported, so that SIGINT or SIGTERM while Python is
 loading modules ends the run with one line and the documented code, not a traceback or a
 silent death.
 """
-import signal
 import sys
 
-
-class _Stop(BaseException):
-    pass
-
-
-def _on_sigterm(_signum, _frame):
-    raise _Stop()
+from . import signals
 
 
 def main():
-    signal.signal(signal.SIGTERM, _on_sigterm)
+    signals.install()
     try:
         from .cli import main as command
     except KeyboardInterrupt:
         sys.stderr.write("srarap: error: interrupted; no output written\n")
         sys.exit(130)
-    except _Stop:
+    except signals.Terminated:
         sys.stderr.write("srarap: error: terminated; no output written\n")
         sys.exit(143)
     command(prog_name="srarap")

@@ -1,5 +1,6 @@
 """Small meshes made in the tests (no files needed)."""
 import os
+import subprocess
 
 import numpy as np
 import pytest
@@ -70,3 +71,23 @@ def symmetric_tube(length=6.0, rings=12, segments=8):
         F.extend([f[i], f[(i + 1) % 4], nxt] for i in range(4))
         nxt += 1
     return np.vstack(V), np.array(F)
+
+
+def stderr_on_a_terminal(cmd, timeout=600):
+    """What ``cmd`` writes to stderr when stderr is a terminal (a pseudo-terminal), decoded."""
+    import pty
+    import select
+    master, slave = pty.openpty()
+    subprocess.run(cmd, stderr=slave, stdout=subprocess.DEVNULL, check=True, timeout=timeout)
+    os.close(slave)
+    seen = b""
+    while select.select([master], [], [], 0.5)[0]:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:  # the other end is closed once everything is read
+            break
+        if not chunk:
+            break
+        seen += chunk
+    os.close(master)
+    return seen.decode(errors="replace")

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 from click.testing import CliRunner
-from helpers import ROOT, tube_mesh
+from helpers import ROOT, stderr_on_a_terminal, tube_mesh
 
 from srarap_cli.animation import Animator
 from srarap_cli.cli import main
@@ -153,25 +153,9 @@ def test_output_pattern_needs_a_frame_field(tmp_path):
 
 
 def test_progress_shows_on_a_terminal_and_stays_quiet_in_a_pipe(tmp_path):
-    import pty
-    import select
-
     cmd = [sys.executable, "-m", "srarap_cli", "animate", BAR, TWIST, "-o",
            str(tmp_path / "f{:02d}.obj"), "--frames", "5"]
-    master, slave = pty.openpty()
-    subprocess.run(cmd, stderr=slave, stdout=subprocess.DEVNULL, check=True, timeout=120)
-    os.close(slave)
-    seen = b""
-    while select.select([master], [], [], 0.5)[0]:
-        try:
-            chunk = os.read(master, 4096)
-        except OSError:  # the other end is closed once everything is read
-            break
-        if not chunk:
-            break
-        seen += chunk
-    os.close(master)
-    text = seen.decode(errors="replace")
+    text = stderr_on_a_terminal(cmd, timeout=120)
     assert "frame 5/5" in text and "frames/s" in text and "ETA" in text
     piped = subprocess.run(cmd, capture_output=True, text=True, check=True)
     assert "frame 5/5" not in piped.stderr and "srarap animate: 5 frames" in piped.stderr

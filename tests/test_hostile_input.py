@@ -341,7 +341,7 @@ def test_a_signal_after_the_commit_reports_what_was_written(tmp_path):
 
 def test_sigterm_while_still_importing_is_one_line_and_143():
     code = ("import os, signal, sys\nsys.argv = ['srarap', '--help']\n"
-            "import srarap_cli.entry as e\nsignal.signal(signal.SIGTERM, e._on_sigterm)\n"
+            "import srarap_cli.entry as e\n"
             "import builtins\nreal = builtins.__import__\n"
             "def slow(name, *a, **k):\n"
             "    if name == 'click':\n"

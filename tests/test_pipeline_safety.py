@@ -7,7 +7,7 @@ import subprocess
 import sys
 
 import pytest
-from helpers import ROOT, tube_mesh
+from helpers import ROOT, stderr_on_a_terminal, tube_mesh
 
 from srarap_cli.mesh_io import write_mesh
 
@@ -99,26 +99,11 @@ def test_standard_input_and_output_with_formats(folder):
 
 @pytest.mark.slow
 def test_a_long_deform_shows_progress_on_a_terminal_only(tmp_path):
-    import pty
-    import select
     spot = os.path.join(ROOT, "sample_meshes", "spot.obj")
     nod = os.path.join(ROOT, "configs", "spot-nod.yaml")
     cmd = [sys.executable, "-m", "srarap_cli", "deform", spot, nod, "-o", str(tmp_path / "o.obj"),
            "--accel", "none", "--start", "laplacian", "--tol", "0", "--max-iter", "150"]
-    master, slave = pty.openpty()
-    subprocess.run(cmd, stderr=slave, stdout=subprocess.DEVNULL, check=True, timeout=600)
-    os.close(slave)
-    seen = b""
-    while select.select([master], [], [], 0.5)[0]:
-        try:
-            chunk = os.read(master, 4096)
-        except OSError:
-            break
-        if not chunk:
-            break
-        seen += chunk
-    os.close(master)
-    text = seen.decode(errors="replace")
+    text = stderr_on_a_terminal(cmd)
     assert "\riteration " in text and "energy " in text and "change " in text
     piped = subprocess.run(cmd, capture_output=True, text=True, check=True, timeout=600)
     assert "\riteration" not in piped.stderr and "srarap deform:" in piped.stderr

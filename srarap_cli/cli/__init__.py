@@ -8,8 +8,8 @@ import sys
 
 import click
 
+from .. import signals
 from ..threads import pin_process
-from . import signals
 
 #: name -> (module, function, one-line help shown by ``srarap --help``)
 COMMANDS = {

@@ -7,11 +7,10 @@ import traceback
 import click
 import numpy as np
 
-from .. import exit_codes
+from .. import exit_codes, signals
 from ..errors import InputError, NumericalError, OutputError, SingularSystemError
 from ..mesh_io.commit import COMMITTED
-from . import signals
-from .signals import Terminated
+from ..signals import Terminated
 
 
 def fail(code, message):

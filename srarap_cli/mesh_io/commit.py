@@ -62,12 +62,12 @@ def _sweep(folder):
         try:
             pid = int(os.path.basename(tmp).split("-")[1])
             os.kill(pid, 0)
-        except ValueError:
+        except ValueError:  # not a name this module makes: not ours to delete
             continue
         except ProcessLookupError:
             try:
                 os.unlink(tmp)
-            except OSError:
+            except OSError:  # another run swept it first: the goal is met either way
                 pass
         except OSError:  # alive but not ours to signal: leave it
             continue
