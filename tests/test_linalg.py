@@ -7,7 +7,7 @@ from srarap_cli import Deformer, linalg
 from srarap_cli.quaternion import from_axis_angle, to_matrix
 
 
-def test_cholesky_back_end_solves_spd_systems(monkeypatch):
+def test_nested_dissection_back_end_solves_spd_systems(monkeypatch):
     rng = np.random.default_rng(1)
     M = sp.random(30, 30, density=0.2, random_state=2)
     A = (M @ M.T + sp.eye(30) * 0.5).tocsr()
