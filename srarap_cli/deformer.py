@@ -39,7 +39,7 @@ class DeformResult:
     positions : (n, 3) float array
     rotors : (n, 4) float array, unit quaternions (w, x, y, z) of the vertex cells
     log : list of dict, one per iteration (0 is the start), keys ``solve_log.LOG_FIELDS``
-    converged : bool, relative energy change fell below ``tol``
+    converged : bool, the stopping test passed (see ``solve``'s ``tol``)
     iterations : int, local/global iterations run
     coarse_log : bool (class attribute), the log follows another mesh than the result
     """
@@ -148,7 +148,7 @@ class Deformer:
         self.labels = (connected_groups(self.graph.laplacian, self.constrained)
                        if labels is None else np.asarray(labels, dtype=np.int64).ravel())
         self.edges = RestEdges(self.graph, self.V)
-        self.energy_floor = 1e-14 * max(float(self.graph.c @ self.edges.q_sq), 1e-300)
+        self.energy_scale = max(float(self.graph.c @ self.edges.q_sq), 1e-300)
         self.diagonal = float(np.linalg.norm(np.ptp(self.V, axis=0)))
         self._bending_alpha = self.alpha if METHODS[method].bending else 0.0
         self._poisson = self._local_step = None
@@ -217,8 +217,10 @@ class Deformer:
         ----------
         targets : (k, 3) float array, in the order of ``constrained``
         max_iter : int >= 0, local/global iterations at most
-        tol : float, stop when ``|E_k - E_{k-1}| <= tol * |E_{k-1}|`` (and the step moved
-            no vertex by more than ``sqrt(tol)`` of the bounding-box diagonal)
+        tol : float, stop when the relative energy changes ``|E_k - E_{k-1}| / |E_{k-1}|``
+            of the last 3 steps average at most ``tol`` (and the last step moved no vertex
+            by more than ``sqrt(tol)`` of the bounding-box diagonal; see
+            :mod:`srarap_cli.drivers.monitor`)
         time_limit : float, optional; stop (not converged) once this many seconds have passed
         accel : {"anderson", "none"}, the driver: accelerated or plain iteration
         start : str, a name in :data:`srarap_cli.starts.STARTS` (``harmonic``,
@@ -235,7 +237,7 @@ class Deformer:
         targets = api_checks.targets(targets, len(self.constrained))
         self.prepare()
         monitor = Monitor(max_iter=max_iter, tol=tol, time_limit=time_limit,
-                          callback=callback, energy_floor=self.energy_floor,
+                          callback=callback, energy_scale=self.energy_scale,
                           scale=self.diagonal)
         step = self.step_for(targets, tol)
         first = STARTS["warm" if initial is not None else start](step, initial)

@@ -124,8 +124,9 @@ SETTINGS = (
             minimum=1, method="sr-relax"),
     Setting("max_iter", "int", 1000, "Local/global iterations at most.", "solve", minimum=0),
     Setting("tol", "float", 1e-6,
-            "Stop when the relative energy change is at most this (and the last step moved no "
-            "vertex by more than sqrt(tol) of the bounding-box diagonal).", "solve", minimum=0),
+            "Stop when the relative energy change, averaged over the last 3 steps, is at most "
+            "this (and the last step moved no vertex by more than sqrt(tol) of the "
+            "bounding-box diagonal).", "solve", minimum=0),
     Setting("time_limit", "float", None,
             "Stop (not converged) once the solve has run this many seconds.", "solve",
             minimum=0, strict=True, metavar="SECONDS"),
