@@ -182,7 +182,8 @@ def test_multires_settings_parse_and_pick_the_direct_solve_for_small_meshes():
     for bad in ("0%", "100%", "3", "many", True, "-5"):
         with pytest.raises(ValueError):
             parse_size(bad)
-    assert coarse_size("auto", 99_999) is None and coarse_size("auto", 800_000) == 5_000
+    assert coarse_size("auto", 19_999) is None and coarse_size("auto", 800_000) == 5_000
+    assert coarse_size("auto", 20_000) == 5_000
     assert coarse_size(0.02, 100_000) == 2000 and coarse_size(5000, 4000) is None
     assert coarse_size("off", 10**7) is None
 
@@ -258,7 +259,11 @@ def test_parts_without_handles_stay_at_rest_with_the_same_warning_as_a_direct_so
     assert any("without a constrained vertex (258 vertices)" in w for w in d.warnings)
 
 
-def test_one_fine_factorization_serves_transfer_and_final_solve_for_every_pose(monkeypatch):
+@pytest.mark.parametrize("mode, factorizations", [("transfer", 1), ("refine", 0)])
+def test_one_fine_factorization_serves_transfer_and_final_solve_for_every_pose(
+        monkeypatch, mode, factorizations):
+    """transfer: one Dirichlet factorization for all poses; refine starts the fine Deformer
+    (its own factorizations) from the prolonged coarse result and needs none."""
     import igl
 
     from srarap_cli.multires import deformer as module
@@ -267,7 +272,7 @@ def test_one_fine_factorization_serves_transfer_and_final_solve_for_every_pose(m
     real = module.DirichletSolver
     monkeypatch.setattr(module, "DirichletSolver", lambda *a: built.append(1) or real(*a))
     V, F = igl.loop(*igl.loop(*_octahedron()))
-    d = MultiresDeformer(V, F, np.arange(6), size=30)
+    d = MultiresDeformer(V, F, np.arange(6), size=30, mode=mode)
     for shift in (0.5, 1.0, 1.5):
         d.solve(V[:6] + shift, max_iter=5)
-    assert len(built) == 1
+    assert len(built) == factorizations

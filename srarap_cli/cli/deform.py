@@ -1,4 +1,5 @@
 """``srarap deform``: mesh + handle file -> deformed mesh + energy log."""
+import math
 import os
 import sys
 import tempfile
@@ -7,11 +8,13 @@ import click
 
 from .. import exit_codes
 from ..distortion import vertex_distortion
+from ..drivers.monitor import WINDOW
 from ..errors import InputError
 from ..handles import load_handles
 from ..limits import check_solve
 from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
 from ..mesh_io.commit import commit_files
+from ..multires.size import AUTO_THRESHOLD
 from ..pipeline import deform_mesh
 from ..preview import preview_png
 from ..settings import click_options, complete, resolve
@@ -133,7 +136,7 @@ def _summary(result, opts, out):
         state = f"ran the {result.iterations} iterations asked (tol 0)"
     else:
         state = (f"NOT converged after {result.iterations} iterations "
-                 f"({_why(last, opts)}; {_advice(result, opts)})")
+                 f"({_why(result.log, opts)}; {_advice(result, opts)})")
     e = result.energies()
     where = f"coarse energy {last['total']:.6g}; full " if result.coarse_log else ""
     return (f"srarap deform: {state}; {where}energy {e['total']:.6g} (membrane "
@@ -142,11 +145,15 @@ def _summary(result, opts, out):
 
 
 
-def _why(last, opts):
-    if last["rel_change"] > opts["tol"]:
-        return f"relative change {last['rel_change']:.3g} > tol {opts['tol']:g}"
-    return (f"relative change {last['rel_change']:.3g} but the last step still moved a vertex "
-            f"by {last['max_move']:.3g}")
+def _why(log, opts):
+    """Which stopping test failed, with the numbers it compared (see drivers.monitor)."""
+    changes = [r["rel_change"] for r in log[1:][-WINDOW:] if not math.isnan(r["rel_change"])]
+    mean = sum(changes) / len(changes) if changes else float("nan")
+    if not mean <= opts["tol"]:
+        return (f"relative change {mean:.3g} per step over the last {len(changes)} > "
+                f"tol {opts['tol']:g}")
+    return (f"relative change {mean:.3g} per step but the last step still moved a vertex by "
+            f"{log[-1]['max_move']:.3g}")
 
 
 def _advice(result, opts):
@@ -155,7 +162,7 @@ def _advice(result, opts):
         return f"stopped by --time-limit {opts['time_limit']:g}: allow more time"
     tips = [f"raise --max-iter (was {opts['max_iter']})"]
     n = len(result.positions)
-    if opts["multires"] == "off" and n > 100_000:
+    if opts["multires"] == "off" and n >= AUTO_THRESHOLD:
         tips.append(f"--multires auto (a coarse solve starts the {n} vertices closer)")
     if opts["accel"] == "none":
         tips.append("use --accel anderson")
