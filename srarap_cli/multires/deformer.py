@@ -200,8 +200,9 @@ class MultiresDeformer:
         solver's own start (``start``, or the caller's ``initial`` after one step). The
         coarse solution is the better start where the deformation needs rotations the
         handles do not give (the Max bust's translated handles: 2% above the minimum against
-        21%); the harmonic start where the handles give them all (a twisted bar), or where
-        the simplification lost what matters."""
+        21%); the harmonic start where the handles give them all (exact for a rigid motion),
+        or where the simplification lost what matters. One step's energy is an imperfect
+        judge: on a twisted 100k bar the coarse start won it and then converged more slowly."""
         step = self.fine.step_for(targets, tol)
         prolonged = prolong(self.V, self._nearest, self.coarse.vertices, coarse.positions,
                             coarse.rotors)
