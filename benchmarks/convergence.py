@@ -13,7 +13,7 @@ include its coarse solve (its iterations are given apart); no column includes se
 time per logged full-resolution iteration; `ms/step` the default's time per local step (a
 rejected Anderson candidate costs one more local step than its iteration).
 
-Run: python benchmarks/convergence.py [--cases cylinder,max,spot,bar100k,bar135]
+Run: python benchmarks/convergence.py [--cases cylinder,max,spot,bar100k,bar135,spot46k]
      [--repeat 3] [--plain-budget 300] [--json out/convergence.json]
 """
 import argparse
@@ -36,7 +36,9 @@ from srarap_cli.pipeline import problem
 BARS = {os.path.basename(BIG_BAR): [],
         "bar-6k.obj": ["--rings", "120", "--segments", "48"]}
 CASES = {**CASES, "bar135": (os.path.join(OUT, "bar-6k.obj"),
-                             os.path.join(HERE, "cases", "bar-6k-twist135.yaml"))}
+                             os.path.join(HERE, "cases", "bar-6k-twist135.yaml")),
+         "spot46k": (os.path.join(OUT, "spot-46k.obj"),
+                     os.path.join(HERE, "..", "configs", "spot-nod.yaml"))}
 PLAIN = {"accel": "none", "start": "laplacian"}
 DEFAULT = {"accel": "anderson", "start": "harmonic"}
 
@@ -68,6 +70,9 @@ def run_case(name, args):
     if bar is not None and not os.path.exists(mesh_path):
         subprocess.run([sys.executable, os.path.join(HERE, "make_big_bar.py"), mesh_path, *bar],
                        check=True)
+    if name == "spot46k" and not os.path.exists(mesh_path):
+        subprocess.run([sys.executable, os.path.join(HERE, "make_big_spot.py"), mesh_path,
+                        "--levels", "1"], check=True)
     mesh = read_mesh(mesh_path)
     p = problem(mesh, load_handles(handles, mesh.vertices))
     d = Deformer(p.V, p.F, p.ids, labels=p.labels)
