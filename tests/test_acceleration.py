@@ -143,6 +143,10 @@ def test_cli_options_choose_the_driver_and_an_unconverged_run_says_what_to_try(t
                                   "--max-iter", "3"])
     assert r.exit_code == 3
     assert "try: raise --max-iter (was 3), use --accel anderson, --start harmonic" in r.stderr
+    assert "relative change" in r.stderr and "per step over the last 3 > tol 1e-06" in r.stderr
+    r = CliRunner().invoke(main, ["deform", bar_obj, twist_yaml, "-o", str(tmp_path / "o.obj"),
+                                  "--max-iter", "0"])
+    assert r.exit_code == 3 and "no iteration ran" in r.stderr and "nan" not in r.stderr
     with open(log) as fh:
         assert {row["step"] for row in csv.DictReader(fh)} == {"start", "plain"}
     r = CliRunner().invoke(main, ["deform", bar_obj, twist_yaml, "-o", str(tmp_path / "o.obj"),

@@ -148,8 +148,10 @@ def _summary(result, opts, out):
 def _why(log, opts):
     """Which stopping test failed, with the numbers it compared (see drivers.monitor)."""
     changes = [r["rel_change"] for r in log[1:][-WINDOW:] if not math.isnan(r["rel_change"])]
-    mean = sum(changes) / len(changes) if changes else float("nan")
-    if not mean <= opts["tol"]:
+    if not changes:
+        return "no iteration ran"
+    mean = sum(changes) / len(changes)
+    if mean > opts["tol"]:
         return (f"relative change {mean:.3g} per step over the last {len(changes)} > "
                 f"tol {opts['tol']:g}")
     return (f"relative change {mean:.3g} per step but the last step still moved a vertex by "
@@ -168,5 +170,7 @@ def _advice(result, opts):
         tips.append("use --accel anderson")
     if opts["start"] == "laplacian":
         tips.append("--start harmonic")
-    tips.append(f"or loosen --tol (the last change was {result.log[-1]['rel_change']:.2g})")
+    last = result.log[-1]["rel_change"]
+    if not math.isnan(last):
+        tips.append(f"or loosen --tol (the last change was {last:.2g})")
     return "try: " + ", ".join(tips)
