@@ -14,6 +14,7 @@ Run: python benchmarks/make_big_spot.py out/spot-738k.obj --levels 3
          out/spot-738k.obj:5000 --repeat 3
 """
 import argparse
+import importlib.util
 import statistics
 import time
 
@@ -78,10 +79,9 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
     tools = {"srarap": ours}
-    try:
-        import pymeshlab  # noqa: F401
+    if importlib.util.find_spec("pymeshlab") is not None:
         tools["pymeshlab"] = meshlab_subset
-    except ImportError:
+    else:
         print("pymeshlab not importable: the peer is left out")
     for case in args.cases:
         path, size = case.rsplit(":", 1)
