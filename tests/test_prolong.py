@@ -8,6 +8,7 @@ from srarap_cli.multires import MultiresDeformer
 from srarap_cli.multires.prolong import nearest_coarse, prolong
 from srarap_cli.operators import cell_graph
 from srarap_cli.quaternion import to_matrix
+from srarap_cli.rest_edges import RestEdges
 
 
 def test_nearest_coarse_vertex_follows_the_edges_not_the_straight_line():
@@ -18,7 +19,7 @@ def test_nearest_coarse_vertex_follows_the_edges_not_the_straight_line():
     n = len(path)
     F = np.array([t for k in range(n - 1)
                   for t in ([k, k + 1, n + k + 1], [k, n + k + 1, n + k])])
-    nearest = nearest_coarse(V, cell_graph(V, F), np.array([0, 6]))
+    nearest = nearest_coarse(RestEdges(cell_graph(V, F), V), np.array([0, 6]))
     # along the left arm vertex k is k from the foot and 5.5 - k from the top
     assert nearest[:n].tolist() == [0, 0, 0] + [1] * (n - 3)
     assert np.array_equal(nearest[n:], nearest[:n])
@@ -27,7 +28,8 @@ def test_nearest_coarse_vertex_follows_the_edges_not_the_straight_line():
 def test_a_part_without_coarse_vertices_is_marked_unreached():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 0, 0], [6, 0, 0], [5, 1, 0]])
     F = np.array([[0, 1, 2], [3, 4, 5]])
-    assert nearest_coarse(V, cell_graph(V, F), np.array([1])).tolist() == [0, 0, 0, -1, -1, -1]
+    nearest = nearest_coarse(RestEdges(cell_graph(V, F), V), np.array([1]))
+    assert nearest.tolist() == [0, 0, 0, -1, -1, -1]
     P, R = prolong(V, np.array([0, 0, 0, -1, -1, -1]), np.array([1]), np.array([[1.0, 2, 3]]),
                    np.array([[0.0, 0, 0, 1]]))
     assert np.array_equal(P[3:], V[3:]) and np.array_equal(R[3:], np.tile([1.0, 0, 0, 0], (3, 1)))
@@ -40,7 +42,7 @@ def test_prolonging_a_rigid_motion_reproduces_it_at_every_vertex():
     Rm = to_matrix(q1)
     coarse = np.sort(rng.choice(len(V), 15, replace=False))
     q = np.tile(q1, (coarse.size, 1))
-    P, R = prolong(V, nearest_coarse(V, cell_graph(V, F), coarse), coarse,
+    P, R = prolong(V, nearest_coarse(RestEdges(cell_graph(V, F), V), coarse), coarse,
                    V[coarse] @ Rm.T + t, q)
     assert np.abs(P - (V @ Rm.T + t)).max() < 1e-12
     assert np.abs(np.abs(R @ q[0]) - 1).max() < 1e-12

@@ -8,7 +8,7 @@ import click
 
 from .. import exit_codes
 from ..distortion import vertex_distortion
-from ..drivers.monitor import WINDOW
+from ..drivers.monitor import recent_changes
 from ..errors import InputError
 from ..handles import load_handles
 from ..limits import check_solve
@@ -147,7 +147,7 @@ def _summary(result, opts, out):
 
 def _why(log, opts):
     """Which stopping test failed, with the numbers it compared (see drivers.monitor)."""
-    changes = [r["rel_change"] for r in log[1:][-WINDOW:] if not math.isnan(r["rel_change"])]
+    changes = recent_changes(log)
     if not changes:
         return "no iteration ran"
     mean = sum(changes) / len(changes)

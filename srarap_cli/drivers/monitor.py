@@ -11,7 +11,6 @@ gain (vertices within about ``sqrt(tol * EXACT)`` of the edge lengths of the ans
 relative changes of an energy near rounding level are noise that may never settle.
 """
 import time
-from collections import deque
 
 import numpy as np
 
@@ -23,6 +22,17 @@ WINDOW = 3
 EXACT = 1e-6
 #: relative changes divide by at least this much of the rest shape's scale
 FLOOR = 1e-14
+
+
+def recent_changes(log):
+    """Relative energy changes of the last WINDOW steps of ``log`` after its latest start row
+    (``step`` ending in ``start``), oldest first; what the energy test averages."""
+    changes = []
+    for row in reversed(log):
+        if row["step"].endswith("start") or len(changes) == WINDOW:
+            break
+        changes.append(row["rel_change"])
+    return changes[::-1]
 
 
 class Monitor:
@@ -56,7 +66,6 @@ class Monitor:
         self.energy_floor = FLOOR * energy_scale
         self.exact_energy = max(tol, 0.0) * EXACT * energy_scale
         self.log = []
-        self._recent = deque(maxlen=WINDOW)
         self.converged = False
         self.start = time.perf_counter()
 
@@ -87,8 +96,8 @@ class Monitor:
             self.callback(row)
         if previous is None:
             return self.max_iter <= 0
-        self._recent.append(rel)
-        settled = sum(self._recent) <= len(self._recent) * self.tol
+        changes = recent_changes(self.log)
+        settled = sum(changes) <= len(changes) * self.tol
         exact = abs(total) < self.exact_energy
         if (settled or exact) and move <= self.move_tol:
             self.converged = True

@@ -125,7 +125,7 @@ class MultiresDeformer:
         self._build_coarse(options)
         mark = time.perf_counter()
         if mode == "refine":
-            self._nearest = nearest_coarse(self.V, self.fine.graph, self.coarse.vertices)
+            self._nearest = nearest_coarse(self.fine.edges, self.coarse.vertices)
             self.fine.prepare()
         else:
             self._build_transfer()

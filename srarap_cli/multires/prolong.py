@@ -15,14 +15,13 @@ from scipy.sparse.csgraph import dijkstra
 from ..quaternion import IDENTITY, rotate
 
 
-def nearest_coarse(V, graph, coarse_vertices):
+def nearest_coarse(edges, coarse_vertices):
     """Index (into ``coarse_vertices``) of each vertex's nearest coarse vertex along the
     mesh's edges; -1 where none is reachable (a part of the mesh with no coarse vertex).
 
     Parameters
     ----------
-    V : (n, 3) float array
-    graph : CellGraph of the mesh (its directed edges ``I``, ``J``)
+    edges : RestEdges of the mesh (its graph's directed edges and their rest lengths)
     coarse_vertices : (c,) int array
 
     Returns
@@ -32,15 +31,16 @@ def nearest_coarse(V, graph, coarse_vertices):
     Examples
     --------
     >>> from ..operators import cell_graph
+    >>> from ..rest_edges import RestEdges
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0]])
     >>> F = np.array([[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]])
-    >>> nearest_coarse(V, cell_graph(V, F), np.array([0, 5])).tolist()
+    >>> nearest_coarse(RestEdges(cell_graph(V, F), V), np.array([0, 5])).tolist()
     [0, 0, 1, 0, 1, 1]
     """
-    n = len(V)
-    length = np.linalg.norm(V[graph.I] - V[graph.J], axis=1)
+    graph = edges.graph
+    n = graph.n
     # a zero-length edge would read as "no edge" in a sparse matrix
-    length = np.maximum(length, np.finfo(float).tiny)
+    length = np.maximum(np.sqrt(edges.q_sq), np.finfo(float).tiny)
     G = sp.csr_matrix((length, (graph.I, graph.J)), shape=(n, n))
     _, _, source = dijkstra(G, directed=False, indices=coarse_vertices, min_only=True,
                             return_predecessors=True)
