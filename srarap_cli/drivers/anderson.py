@@ -7,6 +7,16 @@ rotors. Anderson's type-II update mixes the last ``m`` values of ``G`` with the 
 best cancel the residuals ``f = G(x) - x`` (a small least-squares problem), which extrapolates
 along the slowly converging directions that make the plain iteration need thousands of steps.
 
+The weights minimize the *rotor* part of ``f`` alone; positions and rotors are then mixed with
+them. The positions of ``G(x)`` are an affine function of its rotors (one Poisson solve), so the
+rotor residual holds all the information, while counting the position residual too weighted
+most what the Poisson solve amplifies (the smooth components). Measured against the joint
+residual (positions scaled to the mean rest edge): iterations to 0.1% of the minimum on the
+cylinder 20 -> 14, bust 17 -> 16, Spot 36 -> 30, bar twisted 135 degrees 8 -> 6, 100k bar
+(coarse-to-fine) 36 -> 21; one loss, the 46k Spot (coarse-to-fine) 18 -> 22, whose stop came
+later (42 -> 75 iterations) but 15 times closer to the minimum (3e-4 -> 2e-5 above it). The
+history stores 4n rotor residuals instead of 7n joint ones.
+
 Energy safeguard: an accelerated iterate is kept only if its energy, with the rotors the
 local step gives it, is not above the last accepted one (up to the rounding of the energy
 evaluation); otherwise the plain step ``G(x)`` is taken. The local step that tests a
@@ -76,8 +86,11 @@ class AndersonMixer:
         self._count = self._next = 0
 
     def mix(self, g, f):
-        """The next iterate from ``g = G(x)`` and ``f = G(x) - x`` (1-D arrays); ``g``
-        itself (the same object) when there is no history yet."""
+        """The next iterate from ``g = G(x)`` and the residual ``f`` (1-D arrays); ``g``
+        itself (the same object) when there is no history yet.
+
+        ``f`` is ``G(x) - x`` or any fixed linear function of it (a part of it, a weighting):
+        the mixing weights minimize its norm, and ``g`` is mixed with them."""
         if self._f is not None:
             self._push(f - self._f, g - self._g)
         self._f, self._g = f, g
@@ -96,7 +109,7 @@ class AndersonMixer:
             return
         if self._dF is None:
             self._dF = np.empty((self.depth, df.size))
-            self._dG = np.empty((self.depth, df.size))
+            self._dG = np.empty((self.depth, dg.size))
             self._gram = np.empty((self.depth, self.depth))
         i = self._next
         self._dF[i], self._dG[i] = df / scale, dg / scale
@@ -135,8 +148,9 @@ def anderson_iteration(step, state, monitor, depth=None):
         R = current.rotors
         g_state = (step.positions(R, current.rotation_matrices), R)
         # mixing needs one sign per rotor across the history: compare on x's hemispheres
-        g = layout.pack(g_state[0], align_hemisphere(R, x.rotors))
-        mixed = mixer.mix(g, g - layout.pack(x.positions, x.rotors))
+        R_aligned = align_hemisphere(R, x.rotors)
+        g = layout.pack(g_state[0], R_aligned)
+        mixed = mixer.mix(g, (R_aligned - x.rotors).ravel())
         accelerated = mixed is not g
         if accelerated:
             candidate, tried = _local(step, *layout.unpack(mixed, R), x.iteration + 1)
@@ -156,25 +170,23 @@ def _local(step, P, R, iteration):
 
 
 class _Layout:
-    """The joint state as one vector: free positions (scaled to the rest edges' length, so
-    that a unit of position residual weighs like a unit of rotor residual), then rotors."""
+    """The joint state as one vector: free positions, then rotors."""
 
     def __init__(self, step):
         d = step.deformer
         self.free = np.setdiff1d(np.arange(len(d.V)), d.fixed)
         self.fixed, self.fixed_targets = d.fixed, step.fixed_targets
-        self.scale = 1.0 / max(float(np.sqrt(np.mean(d.edges.q_sq))), 1e-300)
         self.n = len(d.V)
 
     def pack(self, P, R):
-        return np.concatenate([(P[self.free] * self.scale).ravel(), R.ravel()])
+        return np.concatenate([P[self.free].ravel(), R.ravel()])
 
     def unpack(self, x, R_ref):
         """Positions (constrained ones at their targets) and unit rotors on the hemispheres
         of ``R_ref``."""
         k = 3 * self.free.size
         P = np.empty((self.n, 3))
-        P[self.free] = x[:k].reshape(-1, 3) / self.scale
+        P[self.free] = x[:k].reshape(-1, 3)
         P[self.fixed] = self.fixed_targets
         R = normalize(x[k:].reshape(-1, 4), R_ref)
         return P, align_hemisphere(R, R_ref)
