@@ -29,9 +29,12 @@ class LocalStep(Protocol):
     bending: ClassVar[bool]
     needs_stretch: ClassVar[bool]
 
-    def step(self, S: np.ndarray, s: np.ndarray | None, R_prev: np.ndarray) -> np.ndarray:
+    def step(self, S: np.ndarray, s: np.ndarray | None, R_prev: np.ndarray,
+             forcing: float = 0.0) -> np.ndarray:
         """New unit rotors (n, 4) from the cells' covariances ``S`` (n, 3, 3), stretch ``s``
-        (n,) and the previous rotors ``R_prev`` (n, 4)."""
+        (n,) and the previous rotors ``R_prev`` (n, 4). A step that solves a linear system
+        iteratively may stop once its residual is ``forcing`` times that of ``R_prev``
+        (0: to rounding level); closed-form steps ignore it."""
 
 
 class _Methods(Mapping):

@@ -18,5 +18,5 @@ class ArapRotorStep:
     def __init__(self, edges, constrained, alpha_area, feedback):
         """Nothing to precompute: each step fits rotations to the covariances alone."""
 
-    def step(self, S, s, R_prev):
+    def step(self, S, s, R_prev, forcing=0.0):  # closed form: no forcing
         return closest_rotors(S, R_prev)

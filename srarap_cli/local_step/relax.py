@@ -106,7 +106,7 @@ class RelaxRotorStep:
         self._rows = [(c, self._W[c]) for c in colour_classes(graph)]
         self.sweeps = int(sweeps)
 
-    def step(self, S, s, R_prev):
+    def step(self, S, s, R_prev, forcing=0.0):  # exact per-cell fits: forcing unused
         lam, Q = np.linalg.eigh(membrane_matrices(S, s))
         R = R_prev.copy()
         for _ in range(self.sweeps):

@@ -3,10 +3,11 @@
 Row ``i`` (free vertex) reads ``(sigma_i M_i + tau_i I) R_i - sum_j omega_ij R_j = phi_i R_i^prev``
 with symmetric edge weights ``omega``; columns of constrained vertices move to the right-hand
 side. Rows are strictly block diagonally dominant (``tau_i > sum_j omega_ij``, ``M_i`` PSD), so
-the matrix is symmetric positive definite, solved by conjugate gradients to relative residual
-1e-10, started from the previous rotors (and from nothing else, so a solve depends only on its
-inputs: resumed animations reproduce uninterrupted ones bit for bit); a direct factorization
-takes over should CG stall.
+the matrix is symmetric positive definite, solved by conjugate gradients started from the
+previous rotors (and from nothing else, so a solve depends only on its inputs: resumed
+animations reproduce uninterrupted ones bit for bit); a direct factorization takes over should
+CG stall. CG stops at relative residual 1e-10, or earlier at ``forcing`` times the residual of
+the previous rotors (an inexact local step: its error shrinks with the outer iteration's steps).
 
 Preconditioner: ``alpha A`` grows with the mesh while ``M_i`` does not, so the system is mostly
 the graph coupling ``omega`` (a shifted Laplacian, poorly served by block-Jacobi: 50 to 300 CG
@@ -92,9 +93,9 @@ class RotorSystem:
         b = feedback_pull(self.phi[self.free], R_prev[self.free]) + self._free_to_fixed @ R_fixed
         return A, b.ravel()
 
-    def step(self, S, s, R_prev):
+    def step(self, S, s, R_prev, forcing=0.0):
         """New unit rotors: constrained rotors from their own rows (section 6.2), then one
-        solve for all free rotors."""
+        solve for all free rotors, to ``forcing`` times the previous rotors' residual."""
         D = self.diagonal_blocks(S, s)
         R = R_prev.copy()
         if self.fixed.size:
@@ -103,15 +104,16 @@ class RotorSystem:
                 feedback_pull(self.phi[self.fixed], R_prev[self.fixed]), R_prev[self.fixed])
         if self.free.size:
             A, b = self.free_system(D, R_prev, R[self.fixed])
-            sol = self._solve(A, b, R_prev[self.free].ravel())
+            sol = self._solve(A, b, R_prev[self.free].ravel(), forcing)
             R[self.free] = normalize(sol.reshape(-1, 4), R_prev[self.free])
         return R
 
-    def _solve(self, A, b, x0):
+    def _solve(self, A, b, x0, forcing):
         solve = self._precondition
         precond = spla.LinearOperator(
             A.shape, matvec=lambda v: solve(np.asfortranarray(v.reshape(-1, 4))).ravel())
-        x, info = spla.cg(A, b, x0=x0, rtol=CG_RTOL, atol=0.0, M=precond,
+        atol = forcing * float(np.linalg.norm(b - A @ x0)) if forcing else 0.0
+        x, info = spla.cg(A, b, x0=x0, rtol=CG_RTOL, atol=atol, M=precond,
                           maxiter=max(200, 4 * A.shape[0]))
         if info != 0:
             x = factor(A, symmetric=True)(b)
