@@ -8,9 +8,10 @@ from .state import State
 # How inexactly the local step may solve its rotor system: to this fraction of the previous
 # rotors' residual, at most, and to ``sqrt(tol)`` for tighter solves (a tol-0 solve is exact).
 # Measured, default tol 1e-6: CG iterations per local step Spot 5.35 -> 2.3, bust 9.1 -> 4.0,
-# with the same outer iterations to 0.1% of the minimum; run to tol 1e-13 the shapes moved by
-# 2.6e-7 (bust) and 2.1e-7 (Spot) of the diagonal. Ten times looser (1e-2) cut CG to 2.0-2.1
-# but moved the bust's tight shape by 1.2e-5.
+# with the same outer iterations to 0.1% of the minimum. The bias this leaves in the fixed
+# point, run to tol 1e-13 with the forcing held at 1e-3: 2.6e-7 (bust), 2.1e-7 (Spot), 1.0e-6
+# (test tube) of the diagonal, far below a tol-1e-6 stop's own distance to the minimum. Ten
+# times looser (1e-2) cut CG to 2.0-2.1 but moved the bust's tight shape by 1.2e-5.
 MAX_FORCING = 1e-3
 
 
