@@ -112,9 +112,11 @@ class RotorSystem:
         solve = self._precondition
         precond = spla.LinearOperator(
             A.shape, matvec=lambda v: solve(np.asfortranarray(v.reshape(-1, 4))).ravel())
-        atol = forcing * float(np.linalg.norm(b - A @ x0)) if forcing else 0.0
-        x, info = spla.cg(A, b, x0=x0, rtol=CG_RTOL, atol=atol, M=precond,
-                          maxiter=max(200, 4 * A.shape[0]))
+        # CG for the correction from x0, whose right-hand side is x0's residual: relative to
+        # it, the forcing is CG's own rtol, and CG needs no second product for its residual
+        correction, info = spla.cg(A, b - A @ x0, rtol=forcing,
+                                   atol=CG_RTOL * float(np.linalg.norm(b)), M=precond,
+                                   maxiter=max(200, 4 * A.shape[0]))
         if info != 0:
-            x = factor(A, symmetric=True)(b)
-        return x
+            return factor(A, symmetric=True)(b)
+        return x0 + correction
