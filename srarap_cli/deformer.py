@@ -227,8 +227,8 @@ class Deformer:
             ``laplacian``); ignored when ``initial`` is given (warm start)
         initial : (positions (n, 3), rotors (n, 4)), optional warm start
         callback : callable(dict), called with each log row
-        driver : str, optional, a name in :data:`srarap_cli.drivers.DRIVERS`; overrides
-            ``accel``
+        driver : str or callable, optional, a name in :data:`srarap_cli.drivers.DRIVERS`
+            or a driver itself; overrides ``accel``
 
         Returns
         -------
@@ -241,7 +241,9 @@ class Deformer:
                           scale=self.diagonal)
         step = self.step_for(targets, tol)
         first = STARTS["warm" if initial is not None else start](step, initial)
-        state = DRIVERS[driver or ACCEL_DRIVERS[accel]](step, first, monitor)
+        if not callable(driver):
+            driver = DRIVERS[driver or ACCEL_DRIVERS[accel]]
+        state = driver(step, first, monitor)
         return DeformResult(state.positions, state.rotors, monitor.log, monitor.converged,
                             monitor.iterations)
 

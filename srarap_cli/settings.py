@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import click
 
 from .local_step import METHODS
-from .multires.size import AUTO_SIZE, AUTO_THRESHOLD, parse_size
+from .multires.size import AUTO_RATIO, AUTO_SIZE, AUTO_THRESHOLD, parse_size
 
 #: Edge weights of the Laplacian and the bending term (see :func:`operators.cell_graph`).
 WEIGHT_KINDS = ("cotan", "cotan-clamped", "uniform")
@@ -138,7 +138,9 @@ SETTINGS = (
             "rotors (laplacian editing).", "solve", choices=("harmonic", "laplacian")),
     Setting("multires", "size", "auto",
             "Solve on a simplified mesh of N vertices (or P% of them) and carry the result to "
-            f"the full mesh; auto = off below {AUTO_THRESHOLD} vertices, else {AUTO_SIZE}.",
+            f"the full mesh; auto = off below {AUTO_THRESHOLD} vertices, else {AUTO_SIZE} or "
+            f"1/{AUTO_RATIO} of them, whichever is more (coarse meshes of {AUTO_THRESHOLD} or "
+            "more vertices are solved through a coarser one again).",
             "build", metavar="N|P%|off|auto"),
     Setting("multires_mode", "choice", "refine",
             "With multires: refine = the transferred result starts full-resolution iterations "

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from srarap_cli.mesh_io.mesh import Mesh
+from srarap_cli.quaternion import from_axis_angle, to_matrix
 from srarap_cli.samples import bar
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -91,3 +92,15 @@ def stderr_on_a_terminal(cmd, timeout=600):
         seen += chunk
     os.close(master)
     return seen.decode(errors="replace")
+
+
+def twist(V, ids, length, degrees):
+    """Top end turned about the tube's axis, bottom end fixed."""
+    T = V[ids].copy()
+    top = T[:, 2] > length / 2
+    T[top] = T[top] @ to_matrix(from_axis_angle([0, 0, 1], degrees)).T
+    return T
+
+
+def diagonal(V):
+    return float(np.linalg.norm(np.ptp(V, axis=0)))

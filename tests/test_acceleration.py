@@ -2,20 +2,12 @@
 and rigid motions (math that does not depend on the accelerated code)."""
 import numpy as np
 import pytest
-from helpers import ends, tube
+from helpers import diagonal, ends, tube, twist
 
 from srarap_cli import Deformer
 from srarap_cli.drivers.anderson import ROUNDING
 from srarap_cli.multires import MultiresDeformer
 from srarap_cli.quaternion import from_axis_angle, to_matrix
-
-
-def twist(V, ids, length, degrees):
-    """Top end turned about the tube's axis, bottom end fixed."""
-    T = V[ids].copy()
-    top = T[:, 2] > length / 2
-    T[top] = T[top] @ to_matrix(from_axis_angle([0, 0, 1], degrees)).T
-    return T
 
 
 def bend(V, ids, length):
@@ -30,10 +22,6 @@ def bend(V, ids, length):
 def long_tube():
     V, F = tube(length=6.0, rings=24, segments=12)
     return V, F, ends(V, 6.0)
-
-
-def diagonal(V):
-    return float(np.linalg.norm(np.ptp(V, axis=0)))
 
 
 @pytest.mark.parametrize("method", ["sr-linear-sym", "sr-relax", "arap"])

@@ -1,7 +1,6 @@
 """The coarse-to-fine start: nearest coarse vertices and the piecewise rigid shape."""
 import numpy as np
-from helpers import ends, random_rotation, tube
-from test_acceleration import twist
+from helpers import ends, random_rotation, tube, twist
 
 from srarap_cli import Deformer
 from srarap_cli.multires import MultiresDeformer

@@ -120,13 +120,14 @@ class AndersonMixer:
         self._next = (i + 1) % self.depth
 
 
-def anderson_iteration(step, state, monitor, depth=None):
+def anderson_iteration(step, state, monitor, depth=None, correction=None):
     """Accelerated iteration with an energy safeguard.
 
     Logs one row per accepted iterate: its positions with the rotors the local step gives
     them (the pair returned). The row's ``step`` says where the iterate came from:
-    ``anderson`` (mixed and accepted), ``plain`` (no history yet) or ``fallback`` (the
-    mixed candidate raised the energy: plain step taken instead).
+    ``anderson`` (mixed and accepted), ``corrected`` (mixed, or the plain step where there
+    is no history yet, plus ``correction``; accepted), ``plain`` (no history yet) or
+    ``fallback`` (the candidate raised the energy: plain step taken instead).
 
     Parameters
     ----------
@@ -134,6 +135,10 @@ def anderson_iteration(step, state, monitor, depth=None):
     state : State, the start
     monitor : Monitor
     depth : int, Anderson history length (default DEFAULT_DEPTH)
+    correction : optional, adds to the rotors of the iterates it is ``due`` for (numbered
+        from 1): ``correction(rotors, residual)`` gives (n, 4) or None from an iterate's
+        rotors and its step's rotor residual (a
+        :class:`~srarap_cli.multires.correction.CoarseCorrection`)
 
     Returns
     -------
@@ -150,15 +155,24 @@ def anderson_iteration(step, state, monitor, depth=None):
         # mixing needs one sign per rotor across the history: compare on x's hemispheres
         R_aligned = align_hemisphere(R, x.rotors)
         g = layout.pack(g_state[0], R_aligned)
-        mixed = mixer.mix(g, (R_aligned - x.rotors).ravel())
-        accelerated = mixed is not g
-        if accelerated:
-            candidate, tried = _local(step, *layout.unpack(mixed, R), x.iteration + 1)
-            accelerated = tried.total <= current.total + ROUNDING * abs(tried.stretch_total)
-        if not accelerated:
+        residual = R_aligned - x.rotors
+        mixed = mixer.mix(g, residual.ravel())
+        kind = "anderson" if mixed is not g else None
+        delta = None
+        if correction is not None and correction.due(x.iteration + 1):
+            delta = correction(x.rotors, residual)
+        if delta is not None:
+            kind, R_new = "corrected", layout.rotors(mixed, R, delta)
+            P_new = step.positions(R_new)
+        elif kind:
+            P_new, R_new = layout.unpack(mixed, R)
+        if kind:
+            candidate, tried = _local(step, P_new, R_new, x.iteration + 1)
+            if tried.total > current.total + ROUNDING * abs(tried.stretch_total):
+                kind = "fallback"
+        if kind in (None, "fallback"):
             candidate, tried = _local(step, *g_state, x.iteration + 1)
-        kind = "anderson" if accelerated else "plain" if mixed is g else "fallback"
-        stop = monitor.record(tried, current, kind=kind)
+        stop = monitor.record(tried, current, kind=kind or "plain")
         x, current = candidate, tried
     return current
 
@@ -184,9 +198,13 @@ class _Layout:
     def unpack(self, x, R_ref):
         """Positions (constrained ones at their targets) and unit rotors on the hemispheres
         of ``R_ref``."""
-        k = 3 * self.free.size
         P = np.empty((self.n, 3))
-        P[self.free] = x[:k].reshape(-1, 3)
+        P[self.free] = x[:3 * self.free.size].reshape(-1, 3)
         P[self.fixed] = self.fixed_targets
-        R = normalize(x[k:].reshape(-1, 4), R_ref)
-        return P, align_hemisphere(R, R_ref)
+        return P, self.rotors(x, R_ref)
+
+    def rotors(self, x, R_ref, delta=0.0):
+        """The rotors of ``x``, plus ``delta`` (n, 4), as unit rotors on the hemispheres of
+        ``R_ref``."""
+        R = x[3 * self.free.size:].reshape(-1, 4) + delta
+        return align_hemisphere(normalize(R, R_ref), R_ref)

@@ -3,11 +3,13 @@ the result to the full mesh the paper's way (rotors spread harmonically, one Poi
 start full-resolution iterations from it (coarse-to-fine)."""
 import time
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
 from .. import api_checks
-from ..deformer import Deformer, DeformResult
+from ..deformer import ACCEL_DRIVERS, Deformer, DeformResult
+from ..drivers.anderson import anderson_iteration
 from ..errors import NumericalError
 from ..group_rotations import group_rotors
 from ..quaternion import IDENTITY
@@ -15,8 +17,10 @@ from ..settings import DEFAULTS
 from ..starts import STARTS
 from ..threads import single_threaded
 from .cache import coarse_mesh
+from .correction import CoarseCorrection
 from .dirichlet import DirichletSolver
 from .prolong import nearest_coarse, prolong
+from .size import coarse_size
 from .transfer import orient_group_rotors, spread_rotors
 
 STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
@@ -72,7 +76,9 @@ class MultiresDeformer:
     nothing. In ``refine`` mode the fine Deformer is prepared to iterate, and each vertex's
     nearest coarse vertex is found once: the full-resolution iterations start from the coarse
     solution moved rigidly with those vertices (:mod:`.prolong`), much closer to the minimum
-    than the paper's transfer.
+    than the paper's transfer, and the coarse mesh corrects their smooth error as they go
+    (:mod:`.correction`). A refine-mode coarse mesh of ``AUTO_THRESHOLD`` vertices or more
+    is itself solved by a MultiresDeformer, through a coarser mesh.
 
     Parameters
     ----------
@@ -88,8 +94,8 @@ class MultiresDeformer:
 
     Attributes
     ----------
-    coarse : CoarseMesh; coarse_deformer, fine : Deformer; stages : dict of precompute
-    seconds; cache_hit : bool; warnings : list of str
+    coarse : CoarseMesh; coarse_deformer : Deformer or MultiresDeformer; fine : Deformer;
+    stages : dict of precompute seconds; cache_hit : bool; warnings : list of str
 
     Examples
     --------
@@ -122,7 +128,7 @@ class MultiresDeformer:
                              prepare=False, **options)
         self.area = self.fine.area
         fine_setup = time.perf_counter() - mark
-        self._build_coarse(options)
+        self._build_coarse(cache, options)
         mark = time.perf_counter()
         if mode == "refine":
             self._nearest = nearest_coarse(self.fine.edges, self.coarse.vertices)
@@ -139,16 +145,21 @@ class MultiresDeformer:
         return {"vertices": int(self.coarse.vertices.size), "of": len(self.V),
                 "cache_hit": self.cache_hit}
 
-    def _build_coarse(self, options):
+    def _build_coarse(self, cache, options):
         start = time.perf_counter()
         cv = self.coarse.vertices
         slot = np.full(len(self.V), -1)
         slot[self.constrained] = np.arange(self.constrained.size)
         in_coarse = slot[cv] >= 0
         self._coarse_slots = slot[cv][in_coarse]
-        self.coarse_deformer = Deformer(self.V[cv], self.coarse.faces, np.flatnonzero(in_coarse),
-                                        area=self.area, labels=self.labels[self._coarse_slots],
-                                        **options)
+        args = (self.V[cv], self.coarse.faces, np.flatnonzero(in_coarse))
+        labels = self.labels[self._coarse_slots]
+        size = coarse_size("auto", cv.size) if self.mode == "refine" else None
+        if size is None:
+            self.coarse_deformer = Deformer(*args, area=self.area, labels=labels, **options)
+        else:  # a level between: coarse-to-fine and corrections from a coarser mesh again
+            self.coarse_deformer = MultiresDeformer(*args, labels, size=size, cache=cache,
+                                                    area=self.area, **options)
         self.stages["coarse_precompute"] = time.perf_counter() - start
 
     def _build_transfer(self):
@@ -185,7 +196,8 @@ class MultiresDeformer:
         stages["fine_start"] = time.perf_counter() - mark
         mark = time.perf_counter()
         fine = self.fine.solve(targets, initial=(first.positions, first.rotors),
-                               callback=callback, **solve_options)
+                               callback=callback, driver=self._driver(targets, tol, accel),
+                               **solve_options)
         stages["fine_iterations"] = time.perf_counter() - mark
         offset, elapsed = len(log), mark - begin
         log += [dict(row, iteration=row["iteration"] + offset, seconds=row["seconds"] + elapsed)
@@ -193,6 +205,23 @@ class MultiresDeformer:
         return MultiresResult(fine.positions, fine.rotors, log, fine.converged,
                               coarse.iterations + fine.iterations, coarse_log=False,
                               full_energy=fine.energies(), stages=stages, coarse=self.info)
+
+    def coarse_correction(self, targets, tol=DEFAULTS["tol"]):
+        """The :class:`~.correction.CoarseCorrection` of the full-resolution iterates for
+        ``targets`` (k, 3) (refine mode)."""
+        level, coarse_targets = self.coarse_deformer, targets[self._coarse_slots]
+        inner = None
+        if isinstance(level, MultiresDeformer):
+            level, inner = level.fine, level.coarse_correction(coarse_targets, tol)
+        return CoarseCorrection(level.step_for(coarse_targets, tol), self.coarse.vertices,
+                                self._nearest, inner)
+
+    def _driver(self, targets, tol, accel):
+        """The full-resolution driver: the accelerated one with coarse-grid corrections;
+        the plain iteration stays plain."""
+        if ACCEL_DRIVERS[accel] != "anderson":
+            return None
+        return partial(anderson_iteration, correction=self.coarse_correction(targets, tol))
 
     def _fine_start(self, targets, tol, coarse, start, initial):
         """The lower-energy of two full-resolution starts: one local/global step from the
