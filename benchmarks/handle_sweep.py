@@ -11,7 +11,10 @@ Laplacian editing, the peer, in the same run (slow: hundreds of iterations per s
 To compare two versions of the solver, run the sweep on each (the other one through
 ``PYTHONPATH=<worktree of it>``) and compare the totals.
 
-Run: python benchmarks/handle_sweep.py [MESH ...] [--plain]
+``--multires`` solves as ``deform`` does, through ``make_deformer`` (meshes of 20,000 vertices
+or more coarse-to-fine), and counts full-resolution iterations.
+
+Run: python benchmarks/handle_sweep.py [MESH ...] [--plain] [--multires]
      (default meshes: the shared torus, hand, armadillo and the 6k bar of make_big_bar.py)
 """
 import argparse
@@ -24,6 +27,7 @@ import numpy as np
 from run_bench import HERE, OUT, SHARED
 
 from srarap_cli import Deformer
+from srarap_cli.oneshot import make_deformer
 from srarap_cli.quaternion import from_axis_angle, to_matrix
 
 BAR = os.path.join(OUT, "bar-6k.obj")
@@ -41,7 +45,7 @@ def handle_sets(V):
         centre = V[top].mean(axis=0)
         turn_axis = np.eye(3)[up]
         for degrees, shift in MOVES:
-            turn = to_matrix(from_axis_angle(turn_axis, np.radians(degrees))[None])[0]
+            turn = to_matrix(from_axis_angle(turn_axis, degrees)[None])[0]
             moved = (V[top] - centre) @ turn.T + centre
             moved[:, up] += shift * ext[axis]
             labels = np.r_[np.zeros(bottom.size, int), np.ones(top.size, int)]
@@ -53,22 +57,29 @@ def within(log, best, frac):
     return next((k for k, row in enumerate(log) if row["total"] <= best * (1 + frac)), None)
 
 
-def sweep(path, plain):
+def fine_rows(log):
+    """The full-resolution rows of a log (a coarse-to-fine log starts with coarse ones)."""
+    return [row for row in log if not row["step"].startswith("coarse-")]
+
+
+def sweep(path, plain, multires):
     V, F = igl.read_triangle_mesh(path)[:2]
     diag = float(np.linalg.norm(np.ptp(V, axis=0)))
     totals = np.zeros(3, int)
     for name, ids, targets, labels in handle_sets(V):
-        d = Deformer(V, F, ids, labels=labels)
+        d = (make_deformer if multires else Deformer)(V, F, ids, labels=labels)
         tight = d.solve(targets, tol=1e-11, max_iter=20000)
         run = d.solve(targets, max_iter=3000)
-        best = min(tight.energy, min(row["total"] for row in run.log))
-        counts = [within(run.log, best, 1e-3), within(run.log, best, 1e-4), len(run.log) - 1]
+        rows = fine_rows(run.log)
+        best = min(tight.energy, min(row["total"] for row in rows))
+        counts = [within(rows, best, 1e-3), within(rows, best, 1e-4), len(rows) - 1]
         totals += [c if c is not None else 3000 for c in counts]
         dist = np.linalg.norm(run.positions - tight.positions, axis=1).max() / diag
         line = (f"| {os.path.basename(path)} | {name} | {counts[0]} | {counts[1]} | {counts[2]} "
                 f"| {dist:.1e} |")
         if plain:
-            slow = d.solve(targets, accel="none", start="laplacian", tol=1e-9, max_iter=20000)
+            slow = Deformer(V, F, ids, labels=labels).solve(
+                targets, accel="none", start="laplacian", tol=1e-9, max_iter=20000)
             line += f" {within(slow.log, best, 1e-3)} |"
         print(line, flush=True)
     print(f"| {os.path.basename(path)} | total | {totals[0]} | {totals[1]} | {totals[2]} | |"
@@ -79,6 +90,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("meshes", nargs="*", default=MESHES)
     ap.add_argument("--plain", action="store_true", help="also run the plain iteration")
+    ap.add_argument("--multires", action="store_true",
+                    help="solve as deform does (multires auto: coarse-to-fine from 20,000 "
+                         "vertices), the tight reference too; iterations at full resolution")
     args = ap.parse_args()
     if BAR in args.meshes and not os.path.exists(BAR):
         subprocess.run([sys.executable, os.path.join(HERE, "make_big_bar.py"), BAR,
@@ -87,7 +101,7 @@ def main():
           + (" plain it to 0.1% |" if args.plain else ""))
     print("|---|---|---:|---:|---:|---:|" + ("---:|" if args.plain else ""))
     for path in args.meshes:
-        sweep(path, args.plain)
+        sweep(path, args.plain, args.multires)
 
 
 if __name__ == "__main__":
