@@ -87,7 +87,7 @@ class CoarseCorrection:
         y0 = rotors[self.vertices]
         r = self._average(residual)
         tau = self._map(y0) - y0 - r
-        y = self._fixed_point(y0, tau)
+        y = self._fixed_point(y0, tau, y0 + r)
         if not np.isfinite(y).all():
             return None
         out = np.zeros_like(rotors)
@@ -104,10 +104,12 @@ class CoarseCorrection:
         state = self.step.state(self.step.positions(y), y, energy=False)
         return align_hemisphere(self.step.local(state), y)
 
-    def _fixed_point(self, y, tau):
+    def _fixed_point(self, y, tau, first):
+        """Iterate ``y <- G_c(y) - tau`` from ``y`` whose first value ``first`` is known (the
+        map at ``y`` is what ``tau`` was made from)."""
         mixer = AndersonMixer()
         for k in range(1, (COARSE_STEPS if self.inner is None else NESTED_STEPS) + 1):
-            g = self._map(y) - tau
+            g = first if k == 1 else self._map(y) - tau
             mixed = mixer.mix(g.ravel(), (g - y).ravel()).reshape(y.shape)
             if self.inner is not None and self.inner.due(k):
                 delta = self.inner(y, g - y)
