@@ -110,9 +110,10 @@ class CoarseCorrection:
         mixer = AndersonMixer()
         for k in range(1, (COARSE_STEPS if self.inner is None else NESTED_STEPS) + 1):
             g = first if k == 1 else self._map(y) - tau
-            mixed = mixer.mix(g.ravel(), (g - y).ravel()).reshape(y.shape)
+            f = g - y
+            mixed = mixer.mix(g.ravel(), f.ravel()).reshape(y.shape)
             if self.inner is not None and self.inner.due(k):
-                delta = self.inner(y, g - y)
+                delta = self.inner(y, f)
                 mixed = mixed if delta is None else mixed + delta
             new = normalize(mixed, y)
             settled = np.abs(new - y).max(initial=0.0) <= COARSE_SETTLED
