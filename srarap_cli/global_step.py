@@ -22,8 +22,15 @@ class PoissonSolver:
     def __init__(self, graph, constrained):
         self.fixed = np.flatnonzero(constrained)
         K = graph.laplacian
-        keep = sp.diags((~constrained).astype(float))
-        self._solve = factor(keep @ K @ keep + sp.diags(constrained.astype(float)), symmetric=True)
+        free = ~constrained
+        inside = free[graph.I] & free[graph.J]
+        # every free-free mesh edge stays in the pattern, a clamped weight of 0 included: the
+        # rotor preconditioner has the same one, and one fill-reducing ordering serves both
+        ids = np.arange(graph.n)
+        A = sp.csr_matrix((np.r_[-graph.c[inside], np.where(free, K.diagonal(), 1.0)],
+                           (np.r_[graph.I[inside], ids], np.r_[graph.J[inside], ids])),
+                          shape=K.shape)
+        self._solve = factor(A, symmetric=True)
         self._to_fixed = K[:, self.fixed].tocsr()
         self._free_column = (~constrained).astype(float)[:, None]
 

@@ -1,4 +1,6 @@
 """Sparse factorizations shared by the Poisson solve and the rotor systems' preconditioner."""
+import hashlib
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -47,13 +49,7 @@ def factor(A, symmetric):
 
 def _nested_dissection(A):
     """SuperLU of a symmetric ``A`` in METIS's nested dissection order: ``solve(b)``."""
-    import pymetis
-
-    graph = sp.csr_matrix(A, dtype=float, copy=True)
-    graph.setdiag(0)
-    graph.eliminate_zeros()
-    order = np.asarray(pymetis.nested_dissection(
-        pymetis.CSRAdjacency(graph.indptr, graph.indices))[0], dtype=np.int64)
+    order = fill_order(A)
     permuted = sp.csc_matrix(sp.csr_matrix(A)[order][:, order])
     try:
         lu = spla.splu(permuted, permc_spec="NATURAL", options={"SymmetricMode": True})
@@ -67,3 +63,39 @@ def _nested_dissection(A):
         return out
 
     return solve
+
+
+# the Poisson matrix and the rotor preconditioner share their pattern among the free
+# vertices: one nested dissection serves both (3.5 s at 738k vertices)
+_ORDERS = {}
+
+
+def fill_order(A):
+    """METIS nested dissection order of the graph of a symmetric sparse matrix's stored
+    off-diagonal entries (explicit zeros count); vertices without any first. Computed once
+    per pattern of the others.
+
+    Parameters
+    ----------
+    A : (n, n) sparse matrix
+
+    Returns
+    -------
+    (n,) int64 array, a permutation of ``range(n)``
+    """
+    import pymetis
+
+    coo = sp.coo_matrix(A)
+    off = coo.row != coo.col
+    graph = sp.csr_matrix((np.ones(off.sum()), (coo.row[off], coo.col[off])), shape=A.shape)
+    linked = np.diff(graph.indptr) > 0
+    ids = np.flatnonzero(linked)
+    sub = graph[ids][:, ids]
+    sub.sort_indices()
+    key = hashlib.sha256(sub.indptr.astype(np.int64).tobytes()
+                         + sub.indices.astype(np.int64).tobytes()).hexdigest()
+    if key not in _ORDERS:
+        _ORDERS.clear()
+        _ORDERS[key] = np.asarray(pymetis.nested_dissection(
+            pymetis.CSRAdjacency(sub.indptr, sub.indices))[0], dtype=np.int64)
+    return np.concatenate([np.flatnonzero(~linked), ids[_ORDERS[key]]])

@@ -25,10 +25,12 @@ def test_large_mesh_back_end_gives_the_same_deformation(monkeypatch):
     T = V[ids].copy()
     top = T[:, 2] > 3
     T[top] = T[top] @ to_matrix(from_axis_angle([0, 0, 1], 90)).T
-    small = Deformer(V, F, ids).solve(T, max_iter=30)
+    # solved tightly: the single-precision preconditioner's rounding differs between the
+    # orderings, and the inexact local step passes that on to the iterates (1e-6 at tol 1e-6)
+    small = Deformer(V, F, ids).solve(T, tol=1e-12, max_iter=300)
     monkeypatch.setattr(linalg, "LARGE", 0)
-    large = Deformer(V, F, ids).solve(T, max_iter=30)
-    assert small.iterations == large.iterations
+    large = Deformer(V, F, ids).solve(T, tol=1e-12, max_iter=300)
+    assert small.converged and large.converged
     assert np.abs(small.positions - large.positions).max() < 1e-8
 
 

@@ -182,8 +182,9 @@ def test_multires_settings_parse_and_pick_the_direct_solve_for_small_meshes():
     for bad in ("0%", "100%", "3", "many", True, "-5"):
         with pytest.raises(ValueError):
             parse_size(bad)
-    assert coarse_size("auto", 19_999) is None and coarse_size("auto", 800_000) == 25_000
-    assert coarse_size("auto", 20_000) == 5_000 and coarse_size("auto", 160_000) == 5_000
+    assert coarse_size("auto", 19_999) is None and coarse_size("auto", 800_000) == 100_000
+    assert coarse_size("auto", 20_000) == 5_000 and coarse_size("auto", 40_000) == 5_000
+    assert coarse_size("auto", 160_000) == 20_000
     assert coarse_size(0.02, 100_000) == 2000 and coarse_size(5000, 4000) is None
     assert coarse_size("off", 10**7) is None
 

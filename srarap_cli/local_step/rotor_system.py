@@ -49,34 +49,42 @@ class RotorSystem:
         self._fixed_rows = W[self.fixed]
         self._free_to_fixed = W[self.free][:, self.fixed].tocsr()
         W_ff = W[self.free][:, self.free]
-        self._build_pattern(W_ff.tocoo())
+        self._build_pattern(W_ff)
         scalar = sp.diags(tau[self.free] + sigma[self.free] * edges.rest_scale[self.free]) - W_ff
         self._precondition = factor(scalar, symmetric=True) if self.free.size else None
 
-    def _build_pattern(self, free_adj):
+    def _build_pattern(self, W_ff):
         """CSR pattern of the free system, and its data array with the constant off-diagonal
         entries in place: each build writes only the diagonal blocks into it. Gathering all
         40 entries per vertex into fresh arrays made two 240 MB arrays per iteration at 738k
-        vertices, and the kernel zeroes a fresh array's pages (0.14 s for each of those here)."""
-        nf = self.free.size
-        k = np.arange(4)
-        off_r = (4 * free_adj.row[:, None] + k).ravel()
-        off_c = (4 * free_adj.col[:, None] + k).ravel()
-        blk = np.arange(nf)[:, None, None] * 4
-        diag_r = np.broadcast_to(blk + k[:, None], (nf, 4, 4)).ravel()
-        diag_c = np.broadcast_to(blk + k[None, :], (nf, 4, 4)).ravel()
-        rows = np.concatenate([off_r, diag_r])
-        cols = np.concatenate([off_c, diag_c])
+        vertices, and the kernel zeroes a fresh array's pages (0.14 s for each of those here).
+
+        Row ``4i+k`` holds, in column order, entry ``k`` of each neighbour ``j < i``, the four
+        entries of ``i``'s own block, then entry ``k`` of each neighbour ``j > i``: every slot
+        follows from the sorted one-ring, with no sort of the 40 entries per vertex (a
+        lexsort took 5 s at 738k vertices)."""
+        W = sp.csr_matrix(W_ff)
+        W.sort_indices()
+        nf, k = W.shape[0], np.arange(4)
+        deg = np.diff(W.indptr)
+        row = np.repeat(np.arange(nf), deg)
+        after = W.indices > row
+        before = np.bincount(row, weights=~after, minlength=nf).astype(np.int64)
+        length = deg + 4
+        start = 4 * (W.indptr[:-1].astype(np.int64) + 4 * np.arange(nf))
+        rank = np.arange(W.nnz) - W.indptr[row] + 4 * after
+        off = (start[row] + rank)[:, None] + k * length[row][:, None]
+        diag = (start + before)[:, None, None] + k[:, None] * length[:, None, None] + k
+        total = 4 * W.nnz + 16 * nf
         # 32-bit indices: scipy would copy 64-bit ones down to them on every build
-        index = np.int32 if rows.size < np.iinfo(np.int32).max else np.int64
-        order = np.lexsort((cols, rows))
-        self._indices = cols[order].astype(index)
-        self._indptr = np.searchsorted(rows[order], np.arange(4 * nf + 1)).astype(index)
-        slot = np.empty_like(order)
-        slot[order] = np.arange(order.size)  # entry j of (off, diag) lands at slot[j]
-        self._data = np.empty(order.size)
-        self._data[slot[:off_r.size]] = -np.repeat(free_adj.data, 4)
-        self._diagonal_slots = slot[off_r.size:]
+        index = np.int32 if total < np.iinfo(np.int32).max else np.int64
+        self._indices = np.empty(total, index)
+        self._indices[off] = 4 * W.indices[:, None] + k
+        self._indices[diag] = np.broadcast_to(4 * np.arange(nf)[:, None, None] + k, diag.shape)
+        self._indptr = np.append(start[:, None] + k * length[:, None], total).astype(index)
+        self._data = np.empty(total)
+        self._data[off] = -W.data[:, None]
+        self._diagonal_slots = diag.ravel()
 
     def diagonal_blocks(self, S, s):
         """``sigma_i M_i + tau_i I`` (plus a tiny scale-relative shift): (n, 4, 4)."""

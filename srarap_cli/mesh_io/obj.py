@@ -3,6 +3,8 @@
 Written by hand because meshio drops ``vt``/``vn`` indices and rejects UV seams and
 per-corner normals, and libigl's reader keeps no polygons of mixed size or other statements.
 """
+import re
+
 import numpy as np
 
 from ..errors import InputError, excerpt
@@ -37,9 +39,39 @@ def _corner(token, counts, path, lineno):
 
 def read_obj(path):
     """Read an OBJ file into a :class:`Mesh`, keeping vertex and face order."""
-    verts, uvs, norms, sizes, faces, statements = [], [], [], [], [], []
     with open_input(path, encoding="utf-8", errors="replace") as fh:
         text = fh.read().replace("\\\n", " ")
+    return _read_plain(text) or _read_general(text, path)
+
+
+# any line that is not "v ...", "f ..." (no "/" in it), a comment or blank
+_NOT_PLAIN = re.compile(r"^(?!v |f [^/\n]*$|#|[ \t\r]*$)", re.M)
+
+
+def _read_plain(text):
+    """The mesh of a file of only ``v x y z`` and ``f i j k ...`` lines (positive indices),
+    comments and blank lines, parsed in bulk (a 738k-vertex file in a third of the time);
+    None for anything else, which :func:`_read_general` reads or reports."""
+    if _NOT_PLAIN.search(text):
+        return None
+    verts = re.findall(r"^v (.*)$", text, re.M)
+    faces = re.findall(r"^f (.*)$", text, re.M)
+    try:
+        V = np.array(" ".join(verts).split(), dtype=float)
+        corners = np.array(" ".join(faces).split(), dtype=np.int64)
+    except (ValueError, OverflowError):
+        return None
+    sizes = np.fromiter((len(f.split()) for f in faces), dtype=np.int64, count=len(faces))
+    if V.size != 3 * len(verts) or (sizes < 3).any() or (corners < 1).any() \
+            or (corners > len(verts)).any():
+        return None
+    return Mesh(vertices=V.reshape(-1, 3), face_sizes=sizes, face_vertices=corners - 1,
+                statements=[])
+
+
+def _read_general(text, path):
+    """Line by line: every OBJ statement, or a one-line error naming the file and line."""
+    verts, uvs, norms, sizes, faces, statements = [], [], [], [], [], []
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
         if not line or line[0] == "#":
@@ -110,6 +142,17 @@ def _face_lines(mesh):
     return ["f " + " ".join(tok[offsets[i]:offsets[i + 1]]) for i in range(mesh.face_sizes.size)]
 
 
+def _face_block(mesh):
+    """All ``f`` lines at once when every face has one size and no uv or normal ids (most
+    large meshes: a fifth of the time of :func:`_face_lines`); None otherwise."""
+    sizes = mesh.face_sizes
+    if mesh.face_uv is not None or mesh.face_normals is not None or sizes.size == 0 \
+            or (sizes != sizes[0]).any():
+        return None
+    return ("f" + " %d" * int(sizes[0]) + "\n") * sizes.size % tuple(
+        (mesh.face_vertices + 1).tolist())
+
+
 def format_obj(mesh):
     """OBJ text for ``mesh``: deterministic, coordinates with 17 significant digits."""
     lead = [s for k, s in mesh.statements if k == 0]
@@ -123,7 +166,10 @@ def format_obj(mesh):
         parts.append(_rows("vt" + " %.17g" * mesh.uv.shape[1] + "\n", mesh.uv))
     if mesh.normals is not None:
         parts.append(_rows("vn %.17g %.17g %.17g\n", mesh.normals))
-    for i, line in enumerate(_face_lines(mesh)):
+    block = None if later else _face_block(mesh)
+    if block is not None:
+        parts.append(block)
+    for i, line in enumerate([] if block is not None else _face_lines(mesh)):
         parts.extend(s + "\n" for s in later.get(i, ()))
         parts.append(line + "\n")
     parts.extend(s + "\n" for s in later.get(mesh.face_sizes.size, ()))
