@@ -10,6 +10,7 @@ running jobs side by side (``batch --workers``).
 """
 import functools
 import os
+import threading
 
 _VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
@@ -32,3 +33,37 @@ def pin_process():
     first; libraries already loaded keep their pools, which :func:`single_threaded` limits)."""
     for name in _VARIABLES:
         os.environ[name] = "1"
+
+
+def background(func):
+    """Start ``func()`` in a daemon thread; returns ``wait()``, which gives its result or
+    raises its exception.
+
+    For a setup stage that overlaps another one: SuperLU's factorizations and most large
+    numpy operations release the GIL. A daemon thread, so that a signal in the main thread
+    ends the run at once instead of after the background work.
+
+    Examples
+    --------
+    >>> wait = background(lambda: 6 * 7)
+    >>> wait()
+    42
+    """
+    out = {}
+
+    def run():
+        try:
+            out["value"] = func()
+        except BaseException as exc:  # handed to the waiting thread
+            out["error"] = exc
+
+    thread = threading.Thread(target=run, daemon=True)
+    thread.start()
+
+    def wait():
+        thread.join()
+        if "error" in out:
+            raise out["error"]
+        return out["value"]
+
+    return wait

@@ -15,7 +15,7 @@ from ..group_rotations import group_rotors
 from ..quaternion import IDENTITY
 from ..settings import DEFAULTS
 from ..starts import STARTS
-from ..threads import single_threaded
+from ..threads import background, single_threaded
 from .cache import coarse_mesh
 from .correction import CoarseCorrection
 from .dirichlet import DirichletSolver
@@ -121,23 +121,31 @@ class MultiresDeformer:
         self.labels = np.zeros(k, np.int64) if labels is None else np.asarray(labels, np.int64)
         self.n_groups = int(self.labels.max(initial=-1)) + 1
         groups = [self.constrained[self.labels == g] for g in range(self.n_groups)]
+        # the full-resolution setup needs no coarse mesh: it runs beside the simplification
+        # (738k Spot: 50 s one after the other, 35 s side by side on two cores)
+        fine = background(partial(self._fine_setup, area, options))
         self.coarse, self.cache_hit, notes = coarse_mesh(self.V, self.F, size, groups, cache)
         self.stages = {"simplify": time.perf_counter() - start}
-        mark = time.perf_counter()
-        self.fine = Deformer(self.V, self.F, self.constrained, area=area, labels=self.labels,
-                             prepare=False, **options)
+        self.fine, fine_setup = fine()
         self.area = self.fine.area
-        fine_setup = time.perf_counter() - mark
         self._build_coarse(cache, options)
         mark = time.perf_counter()
         if mode == "refine":
             self._nearest = nearest_coarse(self.fine.edges, self.coarse.vertices)
-            self.fine.prepare()
         else:
             self._build_transfer()
         self.stages["factor"] = fine_setup + time.perf_counter() - mark
         self.warnings = (self.fine.warnings + notes
                          + [f"multires: {w}" for w in self.coarse.warnings])
+
+    def _fine_setup(self, area, options):
+        """The full-resolution Deformer (factored in refine mode) and its seconds."""
+        mark = time.perf_counter()
+        fine = Deformer(self.V, self.F, self.constrained, area=area, labels=self.labels,
+                        prepare=False, **options)
+        if self.mode == "refine":
+            fine.prepare()
+        return fine, time.perf_counter() - mark
 
     @property
     def info(self):
