@@ -32,7 +32,7 @@ class PoissonSolver:
                           shape=K.shape)
         self._solve = factor(A, symmetric=True)
         self._to_fixed = K[:, self.fixed].tocsr()
-        self._free_column = (~constrained).astype(float)[:, None]
+        self._free_column = free.astype(float)[:, None]
 
     def bind(self, targets):
         """The solve for one set of constrained positions, reused for many right-hand sides.

@@ -6,7 +6,9 @@ and matrix products by thread count, which changed the last digits of a solve (4
 nothing either: the work here is sparse (SuperLU, Eigen, scipy's sparse products are single
 threaded) and the dense BLAS calls are small, so a second thread only added CPU time, and
 under load (``batch --workers 2`` on 2 cores) it slowed everything down. Parallelism comes from
-running jobs side by side (``batch --workers``).
+running jobs side by side (``batch --workers``), and from one overlap of independent stages
+(:func:`background`: a multiresolution solve's full-resolution setup beside its simplification,
+which do not share data, so the results stay the same bit for bit).
 """
 import functools
 import os
