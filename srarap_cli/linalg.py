@@ -72,8 +72,8 @@ _ORDERS = {}
 
 def fill_order(A):
     """METIS nested dissection order of the graph of a symmetric sparse matrix's stored
-    off-diagonal entries (explicit zeros count); vertices without any first. Computed once
-    per pattern of the others.
+    off-diagonal entries (explicit zeros count); vertices without any come first. METIS runs
+    once per pattern of the others: a second matrix with the same pattern reuses its order.
 
     Parameters
     ----------
