@@ -62,8 +62,12 @@ def bending_energy(graph, R, alpha, area):
     """
     if alpha == 0:
         return 0.0
-    dots = np.einsum("ij,ij->i", np.take(R, graph.I, axis=0), np.take(R, graph.J, axis=0))
     sq = np.einsum("ij,ij->i", R, R)
-    # |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b ; the min takes the sign that agrees
-    dist = np.take(sq, graph.I) + np.take(sq, graph.J) - 2.0 * np.abs(dots)
-    return float(alpha * area * (np.maximum(dist, 0.0) @ graph.edge_inv_degree))
+    total = 0.0
+    for e in graph.edge_blocks():
+        I, J = graph.I[e], graph.J[e]
+        dots = np.einsum("ij,ij->i", np.take(R, I, axis=0), np.take(R, J, axis=0))
+        # |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b ; the min takes the sign that agrees
+        dist = np.take(sq, I) + np.take(sq, J) - 2.0 * np.abs(dots)
+        total += float(np.maximum(dist, 0.0) @ graph.edge_inv_degree[e])
+    return float(alpha * area * total)

@@ -10,7 +10,7 @@ class RestEdges:
 
     Attributes
     ----------
-    q : (m, 3) float array; q_sq : (m,) float array
+    q : (m, 3) float array; q_sq : (m,) float array (computed when read)
     sum_cq : (n, 3) float array, ``a_i = sum_j c_ij q_ij``
     rest_scale : (n,) float array, ``sum_j c_ij |q_ij|^2``, the size of a cell's membrane term
 
@@ -26,40 +26,43 @@ class RestEdges:
 
     def __init__(self, graph, V):
         self.graph = graph
-        self.q = V[graph.J] - V[graph.I]
-        self.q_sq = np.einsum("ij,ij->i", self.q, self.q)
-        n, c = graph.n, graph.c
-        self.sum_cq = graph.cell_sum(c[:, None] * self.q)
-        self.rest_scale = graph.cell_sum(c * self.q_sq)
+        self._V = V
+        q = self.q
+        c, n = graph.c, graph.n
+        self.sum_cq = graph.cell_sum(c[:, None] * q)
+        self.rest_scale = graph.cell_sum(c * np.einsum("ij,ij->i", q, q))
         # S_i[a, b] = sum_j c_ij q_ij[b] (P_j - P_i)[a]: rows b * n + i, the -P_i part on the
         # diagonal, so one sparse product gives every covariance
         rows = np.concatenate([graph.I, np.arange(n)])
         cols = np.concatenate([graph.J, np.arange(n)])
         self._covariance = sp.vstack([
-            sp.csr_matrix((np.concatenate([c * self.q[:, b], -self.sum_cq[:, b]]), (rows, cols)),
+            sp.csr_matrix((np.concatenate([c * q[:, b], -self.sum_cq[:, b]]), (rows, cols)),
                           shape=(n, n)) for b in range(3)]).tocsr()
         # each undirected edge once (weights are symmetric), for the total stretch
         half = graph.I < graph.J
         self._half_I, self._half_J, self._half_c = graph.I[half], graph.J[half], c[half]
         self._rest_total = float(self.rest_scale.sum())
-        # b_i = 1/2 sum_j c_ij (R_i + R_j) q_ij: column 3 j + b holds c_ij q_ij[b] (R_j's
-        # column b), column 3 i + b the cell's own sum_j c_ij q_ij[b] (R_i's)
-        self._divergence = sp.csr_matrix(
-            (0.5 * np.concatenate([c[:, None] * self.q, self.sum_cq]).ravel(),
-             (np.repeat(rows, 3), (3 * cols[:, None] + np.arange(3)).ravel())),
-            shape=(n, 3 * n))
+
+    @property
+    def q(self):
+        """Rest edge vectors ``q_ij`` (m, 3), gathered when asked for: only energy checks
+        and setup need them, and at 738k vertices they would hold 0.1 GB."""
+        return self.deformed(self._V)
+
+    @property
+    def q_sq(self):
+        """``|q_ij|^2``: (m,)."""
+        q = self.q
+        return np.einsum("ij,ij->i", q, q)
 
     def deformed(self, P):
         """Deformed edge vectors ``p_ij = p_j - p_i``: (m, 3)."""
         # np.take: about four times faster than fancy indexing for row gathers
         return np.take(P, self.graph.J, axis=0) - np.take(P, self.graph.I, axis=0)
 
-    def covariance(self, P, p=None):
-        """``S_i = sum_j c_ij p_ij q_ij^T`` (n, 3, 3) and ``s_i = sum_j c_ij(|p|^2 + |q|^2)``.
-
-        ``p`` (from :meth:`deformed`) may be passed when the caller has it already.
-        """
-        return self.cross(P), self.stretch(P, p)
+    def covariance(self, P):
+        """``S_i = sum_j c_ij p_ij q_ij^T`` (n, 3, 3) and ``s_i = sum_j c_ij(|p|^2 + |q|^2)``."""
+        return self.cross(P), self.stretch(P)
 
     def cross(self, P):
         """``S_i = sum_j c_ij p_ij q_ij^T``: (n, 3, 3), from one sparse product."""
@@ -67,17 +70,25 @@ class RestEdges:
         return np.ascontiguousarray(
             (self._covariance @ P).reshape(3, self.graph.n, 3).transpose(1, 2, 0))
 
-    def stretch(self, P, p=None):
+    def stretch(self, P):
         """``s_i = sum_j c_ij(|p_ij|^2 + |q_ij|^2)``: (n,)."""
         g = self.graph
-        p = self.deformed(P) if p is None else p
-        return g.cell_sum(g.c * np.einsum("ij,ij->i", p, p)) + self.rest_scale
+        s = self.rest_scale.copy()
+        for e in g.edge_blocks():
+            I = g.I[e]
+            d = np.take(P, g.J[e], axis=0) - np.take(P, I, axis=0)
+            # I is sorted: bincount adds in the order a one-pass cell sum does
+            s += np.bincount(I, weights=g.c[e] * np.einsum("ij,ij->i", d, d), minlength=g.n)
+        return s
 
     def stretch_total(self, P):
         """``sum_i s_i`` (float), over each undirected edge once: half the work of
         :meth:`stretch` for callers that need only the sum."""
-        d = np.take(P, self._half_J, axis=0) - np.take(P, self._half_I, axis=0)
-        return 2.0 * float(self._half_c @ np.einsum("ij,ij->i", d, d)) + self._rest_total
+        total = 0.0
+        for e in self.graph.edge_blocks(self._half_I.size):
+            d = np.take(P, self._half_J[e], axis=0) - np.take(P, self._half_I[e], axis=0)
+            total += float(self._half_c[e] @ np.einsum("ij,ij->i", d, d))
+        return 2.0 * total + self._rest_total
 
     def rotated_divergence(self, R, Rm=None):
         """``b_i = sum_j c_ij / 2 (R_i q_ij R_i~ + R_j q_ij R_j~)``: (n, 3).
@@ -85,4 +96,8 @@ class RestEdges:
         ``Rm`` (rotation matrices of ``R``) may be passed when the caller has them.
         """
         Rm = to_matrix(R) if Rm is None else Rm
-        return self._divergence @ Rm.transpose(0, 2, 1).reshape(-1, 3)  # rows 3 j + b: R_j[:, b]
+        # c_ij is symmetric and q_ij = -q_ji, so the covariance operator's transpose holds
+        # -c_ij q_ij[b] at (i, b n + j) and -sum_j c_ij q_ij[b] at (i, b n + i): minus twice
+        # this operator, on the columns R_j[:, b] stacked by b (no second 0.2 GB matrix at
+        # 738k vertices, and as fast)
+        return -0.5 * (self._covariance.T @ Rm.transpose(2, 0, 1).reshape(-1, 3))

@@ -12,7 +12,6 @@ class State:
     ----------
     positions : (n, 3) float array
     rotors : (n, 4) float array, unit quaternions (w, x, y, z) of the vertex cells
-    rotation_matrices : (n, 3, 3) float array, the rotors as matrices
     covariances : (n, 3, 3) float array, ``S_i`` of the positions (the next local step's input)
     stretch : (n,) float array or None, per-cell ``s_i`` (only for steps that use it)
     stretch_total : float, ``sum_i s_i``
@@ -22,7 +21,6 @@ class State:
 
     positions: np.ndarray
     rotors: np.ndarray
-    rotation_matrices: np.ndarray
     covariances: np.ndarray
     stretch: np.ndarray
     stretch_total: float

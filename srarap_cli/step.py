@@ -68,7 +68,7 @@ class LocalGlobalStep:
         else:
             s, stretch_total = None, d.edges.stretch_total(P)
         if not energy:
-            return State(P, R, Rm, S, s, stretch_total, float("nan"), float("nan"), iteration)
+            return State(P, R, S, s, stretch_total, float("nan"), float("nan"), iteration)
         return self._evaluate(P, R, to_matrix(R) if Rm is None else Rm, S, s, stretch_total,
                               iteration)
 
@@ -84,4 +84,4 @@ class LocalGlobalStep:
         if not accurate_enough(membrane, stretch_total, self.tol):
             # near-rigid shapes or tol 0: the cancelling form is too coarse, sum residuals
             membrane = membrane_energy(d.graph, d.edges.q, P, R)
-        return State(P, R, Rm, S, s, stretch_total, membrane, d.bending(R), iteration)
+        return State(P, R, S, s, stretch_total, membrane, d.bending(R), iteration)

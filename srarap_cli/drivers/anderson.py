@@ -59,13 +59,17 @@ DEFAULT_DEPTH = 10
 # with rounding near 1e-16 of the total stretch; a candidate whose energy rises by less
 # than that is not worse, and rejecting it would restart the history for nothing.
 ROUNDING = 1e-13
+HISTORY_DTYPE = np.float32
 
 
 class AndersonMixer:
     """Type-II Anderson mixing with a bounded history (``depth`` differences).
 
     Differences are kept normalized in ring buffers with their Gram matrix updated one row
-    at a time, so a mix costs ``O(depth * len(x))``.
+    at a time, so a mix costs ``O(depth * len(x))``. The buffers hold single precision
+    (half the memory: 0.24 GB at 738k vertices), every product with them sums in double: the
+    mixing then works with differences rounded to 6e-8 of their size, and its Gram matrix
+    and weights are those of the rounded differences to double precision.
 
     Parameters
     ----------
@@ -75,7 +79,7 @@ class AndersonMixer:
     --------
     >>> A = np.array([[0.5, 0.2], [0.1, 0.3]])  # a linear contraction, fixed point 0
     >>> mixer, x = AndersonMixer(2), np.array([1.0, 1.0])
-    >>> for _ in range(4):  # plain iteration would still be at |x| ~ 0.4 ** 4
+    >>> for _ in range(5):  # plain iteration would still be at |x| ~ 0.4 ** 5
     ...     g = A @ x
     ...     x = mixer.mix(g, g - x)
     >>> bool(np.abs(x).max() < 1e-15)
@@ -103,27 +107,33 @@ class AndersonMixer:
         k = self._count
         if k == 0:
             return g
-        dF, gram = self._dF[:k], self._gram[:k, :k].copy()
+        gram = self._gram[:k, :k].copy()
         # the columns are unit vectors: a relative ridge keeps near-dependent ones solvable
         gram[np.diag_indices(k)] += 1e-10
-        theta = np.linalg.solve(gram, dF @ f)
-        return g - theta @ self._dG[:k]
+        theta = np.linalg.solve(gram, _products(self._dF[:k], f))
+        # einsum sums in double without a double copy of the history
+        return g - np.einsum("i,ij->j", theta, self._dG[:k], dtype=float)
 
     def _push(self, df, dg):
         scale = np.linalg.norm(df)
         if not scale > 0:
             return
         if self._dF is None:
-            self._dF = np.empty((self.depth, df.size))
-            self._dG = np.empty((self.depth, dg.size))
+            self._dF = np.empty((self.depth, df.size), dtype=HISTORY_DTYPE)
+            self._dG = np.empty((self.depth, dg.size), dtype=HISTORY_DTYPE)
             self._gram = np.empty((self.depth, self.depth))
         i = self._next
         self._dF[i], self._dG[i] = df / scale, dg / scale
         self._count = min(self._count + 1, self.depth)
-        row = self._dF[:self._count] @ self._dF[i]
+        row = _products(self._dF[:self._count], self._dF[i])
         self._gram[i, :self._count] = row
         self._gram[:self._count, i] = row
         self._next = (i + 1) % self.depth
+
+
+def _products(rows, v):
+    """``rows @ v`` summed in double precision, whatever the storage of ``rows``."""
+    return np.einsum("ij,j->i", rows, v, dtype=float)
 
 
 def anderson_iteration(step, state, monitor, depth=None, correction=None):
@@ -174,8 +184,7 @@ def anderson_iteration(step, state, monitor, depth=None, correction=None):
             if tried.total > current.total + ROUNDING * abs(tried.stretch_total):
                 kind = "fallback"
         if kind in (None, "fallback"):
-            candidate, tried = _local(step, step.positions(R, current.rotation_matrices), R,
-                                      x.iteration + 1)
+            candidate, tried = _local(step, step.positions(R), R, x.iteration + 1)
         stop = monitor.record(tried, current, kind=kind or "plain")
         x, current = candidate, tried
     return current

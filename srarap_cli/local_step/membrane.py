@@ -11,7 +11,8 @@ import numpy as np
 
 from ..quaternion import PRODUCT_BASIS
 
-_BASIS_ROWS = PRODUCT_BASIS.reshape(9, 16)  # a matrix product: einsum was 10x slower
+# a matrix product: einsum was 10x slower; the 2 folded in (exact) spares a scaled copy of S
+_TWICE_BASIS_ROWS = 2.0 * PRODUCT_BASIS.reshape(9, 16)
 _DIAG = np.arange(4)
 
 
@@ -25,6 +26,6 @@ def membrane_matrices(S, s):
     >>> float(np.array([1., 0, 0, 0]) @ M[0] @ np.array([1., 0, 0, 0]))  # identity fits
     0.0
     """
-    M = (2.0 * np.reshape(S, (-1, 9)) @ _BASIS_ROWS).reshape(-1, 4, 4)
+    M = (np.reshape(S, (-1, 9)) @ _TWICE_BASIS_ROWS).reshape(-1, 4, 4)
     M[:, _DIAG, _DIAG] += s[:, None]
     return M
