@@ -21,7 +21,7 @@ from .group_rotations import connected_groups
 from .local_step import METHODS
 from .operators import cell_graph
 from .rest_edges import RestEdges
-from .settings import DEFAULTS
+from .settings import DEFAULTS, HANDLE_ROTORS
 from .starts import STARTS
 from .step import LocalGlobalStep
 from .threads import single_threaded
@@ -89,6 +89,19 @@ class Deformer:
         default: fastest to a given energy on the benchmarks), the paper's system itself,
         per-cell relaxation sweeps, or classic ARAP (no bending term).
     sweeps : int, relaxation sweeps per iteration for ``sr-relax``
+    handle_rotors : {"boundary", "lagged"}
+        Which constrained vertices' rotors ``sr-linear-sym`` and ``sr-linear`` take from
+        their own 4x4 rows with the neighbours' previous rotors (the paper's section 6.2),
+        as known values for the one sparse solve: those on a handle's boundary (a free
+        neighbour), the interior of each handle joining the sparse solve (the default), or
+        all of them (``lagged``). Lagged, a rotation reaches the middle of a handle one ring
+        of cells per iteration: large handles, like the Max bust's 2371 of 5272 vertices,
+        took the plain iteration 123 iterations to 0.1% of the minimum against 43 (Spot 896
+        against 168, cylinder 338 against 85). The interior rotors then enter their
+        neighbours' rows unnormalized instead of normalized, which moved the tightly
+        converged shapes of the benchmark cases by at most 1e-5 of the bounding-box diagonal.
+        With ``feedback = 0`` the rule is ``lagged`` (a handle without a boundary, a whole
+        constrained part, would have no right-hand side).
     labels : (k,) int array, optional, handle group of each constrained vertex (the
         rotation-aware start fits one rotation per group); default: the connected patches
         the constrained vertices form
@@ -122,6 +135,7 @@ class Deformer:
                  alpha: float = DEFAULTS["alpha"], feedback: float = DEFAULTS["feedback"],
                  weights: str = DEFAULTS["weights"], area: float | None = None,
                  method: str = DEFAULTS["method"], sweeps: int = DEFAULTS["sweeps"],
+                 handle_rotors: str = DEFAULTS["handle_rotors"],
                  labels: ArrayLike | None = None, prepare: bool = True) -> None:
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
@@ -129,6 +143,10 @@ class Deformer:
             raise ValueError("alpha must be > 0")
         if not feedback >= 0:
             raise ValueError("feedback must be >= 0")
+        if handle_rotors not in HANDLE_ROTORS:
+            raise ValueError(f"handle_rotors must be one of {', '.join(HANDLE_ROTORS)}, "
+                             f"not {handle_rotors!r}")
+        self.handle_rotors = handle_rotors
         self.V, self.F = api_checks.mesh_arrays(V, F)
         self.weights = weights
         self.graph = cell_graph(self.V, self.F, weights)
@@ -160,10 +178,20 @@ class Deformer:
         if self._poisson is None:
             self._poisson = PoissonSolver(self.graph, self._mask)
             extra = {"sweeps": self.sweeps} if self.method == "sr-relax" else {}
-            self._local_step = METHODS[self.method](self.edges, self._mask,
+            self._local_step = METHODS[self.method](self.edges, self._rotor_mask(),
                                                     self.alpha * self.area, self.feedback,
                                                     **extra)
         return self
+
+    def _rotor_mask(self):
+        """Vertices whose rotors the local step takes from their own rows (see
+        ``handle_rotors``), and every vertex nothing can move."""
+        if self.handle_rotors == "lagged" or not self.feedback > 0:
+            return self._mask
+        g, held = self.graph, np.zeros_like(self._mask)
+        held[g.I[self._mask[g.I] & ~self._mask[g.J]]] = True
+        held[self.auto_fixed] = True
+        return held
 
     @property
     def poisson(self):

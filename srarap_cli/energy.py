@@ -69,5 +69,5 @@ def bending_energy(graph, R, alpha, area):
         dots = np.einsum("ij,ij->i", np.take(R, I, axis=0), np.take(R, J, axis=0))
         # |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b ; the min takes the sign that agrees
         dist = np.take(sq, I) + np.take(sq, J) - 2.0 * np.abs(dots)
-        total += float(np.maximum(dist, 0.0) @ graph.edge_inv_degree[e])
+        total += float(np.maximum(dist, 0.0) @ (1.0 / np.take(graph.degree, I)))
     return float(alpha * area * total)

@@ -36,8 +36,6 @@ class CellGraph:
         Total surface area of the mesh.
     degenerate : int
         Triangle angles whose cotangent was not finite (zero-area faces); they count as 0.
-    edge_inv_degree : (m,) float array
-        ``1 / deg_i`` for each directed edge ``i -> j`` (bending weights of the energy).
     """
 
     I: np.ndarray
@@ -47,7 +45,6 @@ class CellGraph:
     laplacian: sp.csr_matrix
     area: float
     degenerate: int = 0
-    edge_inv_degree: np.ndarray = None
 
     @property
     def n(self):
@@ -119,5 +116,4 @@ def cell_graph(V, F, weights="cotan-clamped"):
     area = mesh_area(V, F)
     return CellGraph(I=I, J=W.indices.astype(np.int64), c=W.data.copy(),
                      degree=np.diff(W.indptr), laplacian=K, area=area,
-                     degenerate=int((~finite).sum()),
-                     edge_inv_degree=1.0 / np.diff(W.indptr)[I])
+                     degenerate=int((~finite).sum()))

@@ -38,9 +38,7 @@ class RestEdges:
         self._covariance = sp.vstack([
             sp.csr_matrix((np.concatenate([c * q[:, b], -self.sum_cq[:, b]]), (rows, cols)),
                           shape=(n, n)) for b in range(3)]).tocsr()
-        # each undirected edge once (weights are symmetric), for the total stretch
-        half = graph.I < graph.J
-        self._half_I, self._half_J, self._half_c = graph.I[half], graph.J[half], c[half]
+        self._half = None
         self._rest_total = float(self.rest_scale.sum())
 
     @property
@@ -84,10 +82,17 @@ class RestEdges:
     def stretch_total(self, P):
         """``sum_i s_i`` (float), over each undirected edge once: half the work of
         :meth:`stretch` for callers that need only the sum."""
+        if self._half is None:
+            # each undirected edge once (weights are symmetric); made on first use, as the
+            # methods that need per-cell stretch never call this (53 MB at 738k vertices)
+            g = self.graph
+            half = g.I < g.J
+            self._half = g.I[half], g.J[half], g.c[half]
+        I, J, c = self._half
         total = 0.0
-        for e in self.graph.edge_blocks(self._half_I.size):
-            d = np.take(P, self._half_J[e], axis=0) - np.take(P, self._half_I[e], axis=0)
-            total += float(self._half_c[e] @ np.einsum("ij,ij->i", d, d))
+        for e in self.graph.edge_blocks(I.size):
+            d = np.take(P, J[e], axis=0) - np.take(P, I[e], axis=0)
+            total += float(c[e] @ np.einsum("ij,ij->i", d, d))
         return 2.0 * total + self._rest_total
 
     def rotated_divergence(self, R, Rm=None):

@@ -18,6 +18,8 @@ from .multires.size import AUTO_RATIO, AUTO_SIZE, AUTO_THRESHOLD, parse_size
 
 #: Edge weights of the Laplacian and the bending term (see :func:`operators.cell_graph`).
 WEIGHT_KINDS = ("cotan", "cotan-clamped", "uniform")
+#: How the one-solve local steps get the rotors of constrained vertices (Deformer.handle_rotors).
+HANDLE_ROTORS = ("boundary", "lagged")
 
 
 @dataclass(frozen=True)
@@ -120,6 +122,11 @@ SETTINGS = (
             choices=WEIGHT_KINDS),
     Setting("method", "choice", "sr-linear-sym", "Local step (see README).", "setup",
             choices=tuple(METHODS)),
+    Setting("handle_rotors", "choice", "boundary",
+            "Rotors of constrained vertices: only a handle's boundary cells take theirs from "
+            "their own 4x4 rows, the handle's interior joins the one sparse solve (boundary); "
+            "or every constrained cell from its own row (lagged: the paper's section 6.2).",
+            "setup", choices=HANDLE_ROTORS),
     Setting("sweeps", "int", 2, "Relaxation sweeps per iteration for sr-relax.", "setup",
             minimum=1, method="sr-relax"),
     Setting("max_iter", "int", 1000, "Local/global iterations at most.", "solve", minimum=0),

@@ -112,33 +112,23 @@ def pure(v):
     return np.concatenate([np.zeros((len(v), 1)), v], axis=1)
 
 
-def test_local_step_solves_the_papers_system(bar):
-    """Build the paper's (non-symmetric) rotor system densely from its formula and compare."""
-    V, F, ids = bar
-    d = Deformer(V, F, ids, alpha=ALPHA, feedback=0.2, method="sr-linear")
-    g = d.graph
-    rng = np.random.default_rng(7)
-    P = V + 0.2 * rng.normal(size=V.shape)
-    R_prev = np.array([random_rotation(rng) * 0.1 + IDENTITY for _ in V])
-    R_prev /= np.linalg.norm(R_prev, axis=1, keepdims=True)
-    S, s = d.edges.covariance(P)
-    got = d.local_step.step(S, s, R_prev)
-
-    n, aA, eps = len(V), ALPHA * d.area, 0.2
+def papers_rotor_step(d, P, R_prev, held, eps=0.2):
+    """The paper's (non-symmetric) rotor system, built densely from its formula: the rotors
+    of ``held`` vertices from their own rows with the neighbours' previous rotors (section
+    6.2), then one solve for all others with those as known values; all normalized."""
+    g, V, n, aA = d.graph, d.V, len(d.V), ALPHA * d.area
     M = np.zeros((n, 4, 4))
     for i, j, c in zip(g.I, g.J, g.c):  # M_i = sum c (Rmul(q) - Lmul(p))^T (...)
         q, p = pure((V[j] - V[i])[None]), pure((P[j] - P[i])[None])
         A = np.stack([multiply(e[None], q)[0] - multiply(p, e[None])[0] for e in np.eye(4)], 1)
         M[i] += c * A.T @ A
-    fixed = np.zeros(n, bool)
-    fixed[ids] = True
     expected = R_prev.copy()
-    for i in ids:  # section 6.2, with the neighbours' previous rotors
+    for i in np.flatnonzero(held):
         w = aA / (g.degree[i] + eps)
         rhs = w * (R_prev[g.J[g.I == i]].sum(0) + eps * R_prev[i])
         x = np.linalg.solve(M[i] + aA * np.eye(4), rhs)
         expected[i] = x / np.linalg.norm(x)
-    free = np.flatnonzero(~fixed)
+    free = np.flatnonzero(~held)
     pos = {v: k for k, v in enumerate(free)}
     A = np.zeros((4 * free.size, 4 * free.size))
     b = np.zeros(4 * free.size)
@@ -147,13 +137,73 @@ def test_local_step_solves_the_papers_system(bar):
         A[4 * k:4 * k + 4, 4 * k:4 * k + 4] = M[i] + aA * np.eye(4)
         b[4 * k:4 * k + 4] = w * eps * R_prev[i]
         for j in g.J[g.I == i]:
-            if fixed[j]:
+            if held[j]:
                 b[4 * k:4 * k + 4] += w * expected[j]
             else:
                 A[4 * k:4 * k + 4, 4 * pos[j]:4 * pos[j] + 4] -= w * np.eye(4)
     x = np.linalg.solve(A, b).reshape(-1, 4)
     expected[free] = x / np.linalg.norm(x, axis=1, keepdims=True)
-    assert np.abs(got - expected).max() < 1e-7
+    return expected
+
+
+def perturbed(V, rng):
+    R_prev = np.array([random_rotation(rng) * 0.1 + IDENTITY for _ in V])
+    return V + 0.2 * rng.normal(size=V.shape), R_prev / np.linalg.norm(R_prev, axis=1,
+                                                                         keepdims=True)
+
+
+def test_local_step_solves_the_papers_system(bar):
+    V, F, ids = bar
+    d = Deformer(V, F, ids, alpha=ALPHA, feedback=0.2, method="sr-linear",
+                 handle_rotors="lagged")
+    P, R_prev = perturbed(V, np.random.default_rng(7))
+    got = d.local_step.step(*d.edges.covariance(P), R_prev)
+    held = np.zeros(len(V), bool)
+    held[ids] = True
+    assert np.abs(got - papers_rotor_step(d, P, R_prev, held)).max() < 1e-7
+
+
+def test_only_handle_boundary_rotors_come_from_their_own_rows():
+    """Default rule: a constrained vertex with a free neighbour takes its rotor from its own
+    row; one whose neighbours are all constrained joins the sparse solve."""
+    V, F = tube()
+    ids = np.flatnonzero((V[:, 2] < 1.2) | (V[:, 2] > 4.8))  # three rings at each end
+    d = Deformer(V, F, ids, alpha=ALPHA, feedback=0.2, method="sr-linear")
+    constrained = np.zeros(len(V), bool)
+    constrained[ids] = True
+    g = d.graph
+    held = constrained.copy()
+    held[ids] = [(~constrained[g.J[g.I == i]]).any() for i in ids]
+    assert 0 < held.sum() < constrained.sum()  # the middle rings are interior
+    P, R_prev = perturbed(V, np.random.default_rng(9))
+    got = d.local_step.step(*d.edges.covariance(P), R_prev)
+    assert np.abs(got - papers_rotor_step(d, P, R_prev, held)).max() < 1e-7
+    lagged = papers_rotor_step(d, P, R_prev, constrained)
+    assert np.abs(got - lagged).max() > 1e-3  # the two rules differ after one step
+
+
+def test_both_rotor_rules_converge_to_nearby_shapes():
+    """The rules differ only in which rotors enter their neighbours' rows normalized: the
+    tightly converged shapes of a bent tube with three-ring handles agree to 1e-5 of the
+    diagonal (measured 1.4e-6), and the default rule needs fewer plain iterations (59 against
+    80)."""
+    V, F = tube()
+    ids = np.flatnonzero((V[:, 2] < 1.2) | (V[:, 2] > 4.8))
+    T = bend_targets(V, ids)
+    runs = {rule: Deformer(V, F, ids, handle_rotors=rule).solve(
+        T, tol=1e-12, max_iter=3000, accel="none", start="laplacian")
+        for rule in ("boundary", "lagged")}
+    assert all(r.converged for r in runs.values())
+    diag = np.linalg.norm(np.ptp(V, axis=0))
+    shift = np.abs(runs["boundary"].positions - runs["lagged"].positions).max() / diag
+    assert shift < 1e-5
+    assert runs["boundary"].iterations < runs["lagged"].iterations
+
+
+def test_an_unknown_handle_rotor_rule_is_refused(bar):
+    V, F, ids = bar
+    with pytest.raises(ValueError, match="handle_rotors must be one of boundary, lagged"):
+        Deformer(V, F, ids, handle_rotors="joint")
 
 
 def test_warm_start_from_a_converged_result_stays_put(bar):
