@@ -31,12 +31,12 @@ _REL_SHIFT = 1e-9
 
 
 class RotorSystem:
-    """Pattern and weights of one rotor system, fixed per mesh and constraint set.
+    """Weights and preconditioner of one rotor system, fixed per mesh and set of held rotors.
 
     Parameters
     ----------
     edges : RestEdges
-    constrained : (n,) bool array
+    constrained : (n,) bool array, vertices whose rotors come from their own rows (section 6.2)
     sigma, tau, phi : (n,) float arrays, per-row scale of ``M_i``, diagonal term, feedback
     omega : (m,) float array, symmetric edge weights aligned with ``graph.I, graph.J``
     """
