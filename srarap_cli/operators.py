@@ -5,6 +5,7 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
+from .group_rotations import label_sum
 from .settings import WEIGHT_KINDS
 
 # Half-cotangents are bounded: an angle under ~0.06 degrees (a needle) would otherwise give
@@ -56,14 +57,14 @@ class CellGraph:
         m = self.I.size if m is None else m
         return [slice(a, min(a + EDGE_BLOCK, m)) for a in range(0, m, EDGE_BLOCK)]
 
-    def cell_sum(self, values):
-        """Sum per-edge ``values`` of shape (m, ...) into their source vertex: (n, ...)."""
+    def cell_sum(self, values, edges=slice(None)):
+        """Sum per-edge ``values`` of shape (m, ...) into their source vertex: (n, ...);
+        ``edges`` (a slice) says which edges ``values`` belong to (default all)."""
         flat = values.reshape(values.shape[0], -1)
-        # I is sorted: bincount adds each cell's edges in order, like a sparse incidence
+        # I is sorted: the sums add each cell's edges in order, like a sparse incidence
         # product, without keeping that (n, m) matrix (53 MB at 738k vertices)
-        sums = [np.bincount(self.I, weights=flat[:, k], minlength=self.n)
-                for k in range(flat.shape[1])]
-        return np.stack(sums, axis=1).reshape((self.n,) + values.shape[1:])
+        sums = label_sum(flat, self.I[edges], self.n)
+        return sums.reshape((self.n,) + values.shape[1:])
 
 
 def mesh_area(V, F):

@@ -73,10 +73,8 @@ class RestEdges:
         g = self.graph
         s = self.rest_scale.copy()
         for e in g.edge_blocks():
-            I = g.I[e]
-            d = np.take(P, g.J[e], axis=0) - np.take(P, I, axis=0)
-            # I is sorted: bincount adds in the order a one-pass cell sum does
-            s += np.bincount(I, weights=g.c[e] * np.einsum("ij,ij->i", d, d), minlength=g.n)
+            d = np.take(P, g.J[e], axis=0) - np.take(P, g.I[e], axis=0)
+            s += g.cell_sum(g.c[e] * np.einsum("ij,ij->i", d, d), e)
         return s
 
     def stretch_total(self, P):

@@ -13,6 +13,8 @@ moves, so every check made at the start of the round still holds when all are ap
 """
 import numpy as np
 
+from ..group_rotations import label_sum
+
 #: Weight of the point quadric (distance to the collapsed original vertices) relative to the
 #: plane quadrics, per unit of vertex area: it breaks ties on flat regions in favour of short
 #: collapses and compact clusters, so flat parts do not collapse into slivers (the role of
@@ -200,7 +202,7 @@ def _quality(V, T, normal):
 def _vertex_normals(V, F):
     """Area-weighted unit vertex normals of the input surface."""
     normal = _normals(V, F)
-    out = _sum_into(F.ravel(), np.repeat(normal, 3, axis=0), len(V))
+    out = label_sum(np.repeat(normal, 3, axis=0), F.ravel(), len(V))
     return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
 
 
@@ -269,7 +271,7 @@ def _vertex_quadrics(V, F):
     Q = np.zeros((n, 10))
     face_q = _outer(planes) * (double_area / 6)[:, None]
     for k in range(3):
-        Q += _sum_into(F[:, k], face_q, n)
+        Q += label_sum(face_q, F[:, k], n)
     Q += _border_quadrics(V, F, unit, n)
     area = np.bincount(F.ravel(), weights=np.repeat(double_area / 6, 3), minlength=n)
     point = np.column_stack([np.ones(n), np.zeros(n), np.zeros(n), -V[:, 0], np.ones(n),
@@ -291,18 +293,13 @@ def _border_quadrics(V, F, unit, n):
     side = np.cross(along, unit[face])
     side /= np.maximum(np.linalg.norm(side, axis=1), 1e-300)[:, None]
     q = _outer(np.column_stack([side, -np.einsum("ij,ij->i", side, V[a])])) * length2[:, None]
-    return _sum_into(a, q, n) + _sum_into(b, q, n)
+    return label_sum(q, a, n) + label_sum(q, b, n)
 
 
 def _outer(p):
     """Upper triangles (row-major, 10 entries) of the outer products p p^T, p (m, 4)."""
     i, j = np.triu_indices(4)
     return p[:, i] * p[:, j]
-
-
-def _sum_into(index, values, n):
-    return np.column_stack([np.bincount(index, weights=values[:, k], minlength=n)
-                            for k in range(values.shape[1])])
 
 
 def _lifted(V):

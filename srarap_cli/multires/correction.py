@@ -23,6 +23,7 @@ with it every iteration, 7 / 12 / 20 / 25 every second iteration.
 import numpy as np
 
 from ..drivers.anderson import AndersonMixer
+from ..group_rotations import label_sum
 from ..quaternion import align_hemisphere, normalize
 
 #: coarse steps per correction (Anderson-mixed); 10 took the 46k Spot to 1e-4 in 24
@@ -95,9 +96,8 @@ class CoarseCorrection:
         return out
 
     def _average(self, values):
-        sums = [np.bincount(self._cell, weights=values[self._in_cell, k],
-                            minlength=self.vertices.size) for k in range(values.shape[1])]
-        return np.column_stack(sums) * self._weight[:, None]
+        sums = label_sum(values[self._in_cell], self._cell, self.vertices.size)
+        return sums * self._weight[:, None]
 
     def _map(self, y):
         """The coarse step's rotors from rotors ``y``, on the hemispheres of ``y``."""
