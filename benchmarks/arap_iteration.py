@@ -22,9 +22,9 @@ import igl
 import numpy as np
 
 from srarap_cli import Deformer
-from srarap_cli.handles import load_handles
-from srarap_cli.mesh_io import read_mesh
-from srarap_cli.pipeline import problem
+from srarap_cli.io.handles import load_handles
+from srarap_cli.io.mesh import read_mesh
+from srarap_cli.tasks.pipeline import problem
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)

@@ -1,6 +1,6 @@
 """Time a manifest of many small jobs run sequentially and with 2 worker processes.
 
-Writes small tubes (srarap_cli.samples, as the sample bar) and a manifest of N jobs bending them,
+Writes small tubes (srarap_cli.tasks.samples, as the sample bar) and a manifest of N jobs bending them,
 runs `srarap batch` with --workers 1 and --workers 2 in fresh output folders, and prints both
 wall times and their ratio. One job is deliberately broken: it must be reported, not fatal.
 
@@ -14,7 +14,7 @@ import time
 
 import yaml
 
-from srarap_cli.samples import bar, obj_text
+from srarap_cli.tasks.samples import bar, obj_text
 
 
 def main():

@@ -33,10 +33,10 @@ import numpy as np
 from run_bench import BIG_BAR, CASES, HERE, OUT
 
 from srarap_cli import Deformer
-from srarap_cli.handles import load_handles
-from srarap_cli.mesh_io import read_mesh
-from srarap_cli.oneshot import make_deformer
-from srarap_cli.pipeline import problem
+from srarap_cli.io.handles import load_handles
+from srarap_cli.io.mesh import read_mesh
+from srarap_cli.solver.oneshot import make_deformer
+from srarap_cli.tasks.pipeline import problem
 
 BARS = {os.path.basename(BIG_BAR): [],
         "bar-6k.obj": ["--rings", "120", "--segments", "48"]}

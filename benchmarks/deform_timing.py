@@ -17,9 +17,9 @@ import igl
 import numpy as np
 
 from srarap_cli import Deformer
-from srarap_cli.handles import load_handles
-from srarap_cli.mesh_io import read_mesh
-from srarap_cli.settings import resolve
+from srarap_cli.io.handles import load_handles
+from srarap_cli.io.mesh import read_mesh
+from srarap_cli.solver.settings import resolve
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -35,10 +35,10 @@ CASES = [
 def srarap_run(V, F, c, tol, method):
     opts = resolve(c.solver, {"tol": tol, "method": method})
     t0 = time.perf_counter()
-    d = Deformer(V, F, c.ids, alpha=opts["alpha"], feedback=opts["feedback"],
-                 weights=opts["weights"], method=opts["method"])
+    d = Deformer(V, F, c.ids, alpha=opts.alpha, feedback=opts.feedback,
+                 weights=opts.weights, method=opts.method)
     pre = time.perf_counter() - t0
-    r = d.solve(c.targets, max_iter=opts["max_iter"], tol=tol)
+    r = d.solve(c.targets, max_iter=opts.max_iter, tol=tol)
     per_iter = (r.log[-1]["seconds"] - r.log[0]["seconds"]) / max(r.iterations, 1)
     return pre, per_iter, r
 

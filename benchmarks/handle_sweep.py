@@ -27,8 +27,8 @@ import numpy as np
 from run_bench import HERE, OUT, SHARED
 
 from srarap_cli import Deformer
-from srarap_cli.oneshot import make_deformer
-from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli.solver.oneshot import make_deformer
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 
 BAR = os.path.join(OUT, "bar-6k.obj")
 MESHES = [os.path.join(SHARED, name) for name in ("torus.obj", "hand_lowres.obj",

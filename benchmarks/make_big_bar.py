@@ -5,7 +5,7 @@ Run: python benchmarks/make_big_bar.py OUT.obj [--rings 624] [--segments 160]
 import argparse
 import os
 
-from srarap_cli.samples import bar, obj_text
+from srarap_cli.tasks.samples import bar, obj_text
 
 
 def main():

@@ -10,7 +10,7 @@ import os
 import igl
 import numpy as np
 
-from srarap_cli.mesh_io import read_mesh
+from srarap_cli.io.mesh import read_mesh
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 

@@ -21,18 +21,18 @@ import time
 import numpy as np
 
 from srarap_cli import DeformResult
-from srarap_cli.handles import load_handles
-from srarap_cli.mesh_io import read_mesh
-from srarap_cli.pipeline import build_deformer, problem
-from srarap_cli.settings import resolve
+from srarap_cli.io.handles import load_handles
+from srarap_cli.io.mesh import read_mesh
+from srarap_cli.solver.settings import resolve
+from srarap_cli.tasks.pipeline import build_deformer, problem
 
 
 def use_meshlab():
     """Route the multires simplification through MeshLab's collapse (benchmark peer)."""
     import sys
 
-    import srarap_cli.multires.cache as cache
-    from srarap_cli.multires.simplify import CoarseMesh
+    import srarap_cli.solver.multires.cache as cache
+    from srarap_cli.solver.multires.simplify import CoarseMesh
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from simplify_quality import meshlab_subset
 
@@ -51,7 +51,7 @@ def refit_energy(direct, P, R):
 
 def run(p, opts, size, tol, max_iter):
     start = time.perf_counter()
-    d = build_deformer(p, dict(opts, multires=size))
+    d = build_deformer(p, opts.replace(multires=size))
     r = d.solve(p.targets, max_iter=max_iter, tol=tol)
     return d, r, time.perf_counter() - start
 
@@ -59,7 +59,7 @@ def run(p, opts, size, tol, max_iter):
 def reference(p, opts, args):
     """The direct solve: computed, or read from ``args.reference`` (same inputs assumed)."""
     if args.reference and os.path.exists(args.reference):
-        direct = build_deformer(p, dict(opts, multires="off"))
+        direct = build_deformer(p, opts.replace(multires="off"))
         with np.load(args.reference) as z:
             log = json.loads(str(z["log"]))
             ref = DeformResult(z["positions"], z["rotors"], log, True, len(log) - 1)
@@ -89,7 +89,7 @@ def main():
     mesh = read_mesh(args.mesh)
     c = load_handles(args.handles, mesh.vertices)
     p = problem(mesh, c)
-    opts = dict(resolve(c.solver, {}), multires_mode=args.mode)
+    opts = resolve(c.solver, {"multires_mode": args.mode})
     if args.meshlab:
         use_meshlab()
     direct, ref, direct_s = reference(p, opts, args)

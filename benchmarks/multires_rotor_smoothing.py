@@ -15,11 +15,11 @@ import json
 import numpy as np
 import scipy.sparse as sp
 
-from srarap_cli.handles import load_handles
-from srarap_cli.mesh_io import read_mesh
-from srarap_cli.multires import MultiresDeformer
-from srarap_cli.pipeline import problem
-from srarap_cli.quaternion import IDENTITY, normalize
+from srarap_cli.io.handles import load_handles
+from srarap_cli.io.mesh import read_mesh
+from srarap_cli.solver.multires import MultiresDeformer
+from srarap_cli.solver.quaternion import IDENTITY, normalize
+from srarap_cli.tasks.pipeline import problem
 
 
 def main():

@@ -21,9 +21,9 @@ import time
 import igl
 import numpy as np
 
-from srarap_cli.mesh_io import read_mesh
-from srarap_cli.multires import simplify_to_subset
-from srarap_cli.multires.topology import topology_summary
+from srarap_cli.io.mesh import read_mesh
+from srarap_cli.solver.multires import simplify_to_subset
+from srarap_cli.solver.multires.topology import topology_summary
 
 
 def meshlab_subset(V, F, size):

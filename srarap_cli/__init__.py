@@ -3,14 +3,19 @@
 Public API: :class:`Deformer` (precompute once, solve many times), :func:`deform` (one shot),
 :func:`read_mesh` / :func:`write_mesh`, :func:`load_handles`, :func:`deform_mesh`.
 
+The package is in layers, each importing only those below it: ``cli`` (the command line) ->
+``tasks`` (what a command does) -> ``io`` (files) -> ``solver`` (the paper) -> ``runtime``
+(errors, signals, threads, limits). Each layer's ``__init__`` states its rule.
+
 Names are imported on first use, so that ``import srarap_cli`` and the command line's help
 do not load the numerical stack.
 """
 import importlib
 
-_WHERE = {"Constraints": "handles", "DeformResult": "deformer", "Deformer": "deformer",
-          "Mesh": "mesh_io", "deform": "oneshot", "deform_mesh": "pipeline",
-          "load_handles": "handles", "read_mesh": "mesh_io", "write_mesh": "mesh_io"}
+_WHERE = {"Constraints": "io.handles", "DeformResult": "solver.deformer",
+          "Deformer": "solver.deformer", "Mesh": "io.mesh", "deform": "solver.oneshot",
+          "deform_mesh": "tasks.pipeline", "load_handles": "io.handles", "read_mesh": "io.mesh",
+          "write_mesh": "io.mesh"}
 
 __all__ = sorted(_WHERE)
 

@@ -6,7 +6,7 @@ silent death.
 """
 import sys
 
-from . import signals
+from .runtime import signals
 
 
 def main():

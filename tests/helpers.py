@@ -5,9 +5,9 @@ import subprocess
 import numpy as np
 import pytest
 
-from srarap_cli.mesh_io.mesh import Mesh
-from srarap_cli.quaternion import from_axis_angle, to_matrix
-from srarap_cli.samples import bar
+from srarap_cli.io.mesh.mesh import Mesh
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
+from srarap_cli.tasks.samples import bar
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")

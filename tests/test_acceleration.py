@@ -5,9 +5,9 @@ import pytest
 from helpers import diagonal, ends, tube, twist
 
 from srarap_cli import Deformer
-from srarap_cli.drivers.anderson import ROUNDING
-from srarap_cli.multires import MultiresDeformer
-from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli.solver.drivers.anderson import ROUNDING
+from srarap_cli.solver.multires import MultiresDeformer
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 
 
 def bend(V, ids, length):

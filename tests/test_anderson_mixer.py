@@ -6,7 +6,7 @@ it lands on the fixed point ``(I - A)^-1 c`` after ``k + 2`` maps (up to roundin
 """
 import numpy as np
 
-from srarap_cli.drivers.anderson import AndersonMixer
+from srarap_cli.solver.drivers.anderson import AndersonMixer
 
 
 def _contraction(k, seed):

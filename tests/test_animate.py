@@ -13,14 +13,14 @@ import yaml
 from click.testing import CliRunner
 from helpers import ROOT, stderr_on_a_terminal, tube_mesh
 
-from srarap_cli.animation import Animator
 from srarap_cli.cli import main
-from srarap_cli.errors import InputError
-from srarap_cli.handles import parse_handles
-from srarap_cli.keyframes import slerp
-from srarap_cli.mesh_io import read_mesh
-from srarap_cli.quaternion import from_axis_angle, to_matrix
-from srarap_cli.settings import resolve
+from srarap_cli.io.handles import parse_handles
+from srarap_cli.io.handles.keyframes import slerp
+from srarap_cli.io.mesh import read_mesh
+from srarap_cli.runtime.errors import InputError
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
+from srarap_cli.solver.settings import resolve
+from srarap_cli.tasks.animation import Animator
 
 BASE = {"box": {"min": [-2, -2, -0.01], "max": [2, 2, 0.01]}, "fixed": True}
 TOP_BOX = {"min": [-2, -2, 5.99], "max": [2, 2, 6.01]}

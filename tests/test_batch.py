@@ -7,7 +7,7 @@ from click.testing import CliRunner
 from helpers import ROOT
 
 from srarap_cli.cli import main
-from srarap_cli.mesh_io import read_mesh, write_mesh
+from srarap_cli.io.mesh import read_mesh, write_mesh
 
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
 BEND = os.path.join(ROOT, "configs", "bar-bend.yaml")

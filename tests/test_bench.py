@@ -9,7 +9,7 @@ from click.testing import CliRunner
 from helpers import tube_mesh
 
 from srarap_cli.cli import main
-from srarap_cli.mesh_io import write_mesh
+from srarap_cli.io.mesh import write_mesh
 
 
 @pytest.mark.slow

@@ -12,7 +12,7 @@ from click.testing import CliRunner
 from helpers import ROOT, tube_mesh
 
 from srarap_cli.cli import main
-from srarap_cli.mesh_io import read_mesh, write_mesh
+from srarap_cli.io.mesh import read_mesh, write_mesh
 
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
 TWIST = os.path.join(ROOT, "configs", "bar-twist.yaml")
@@ -183,7 +183,7 @@ def test_json_handles_and_sel_file_through_the_command(small, tmp_path):
 
 
 HEAVY = ("numpy", "scipy", "igl", "meshio", "matplotlib", "distributed", "yaml",
-         "srarap_cli.multires.deformer", "srarap_cli.multires.collapse")
+         "srarap_cli.solver.multires.deformer", "srarap_cli.solver.multires.collapse")
 
 
 @pytest.mark.parametrize("code", ["import srarap_cli",

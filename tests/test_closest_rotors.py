@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from srarap_cli import closest_rotors as module
-from srarap_cli.closest_rotors import closest_rotors
-from srarap_cli.quaternion import IDENTITY, from_axis_angle, to_matrix
+from srarap_cli.solver import closest_rotors as module
+from srarap_cli.solver.closest_rotors import closest_rotors
+from srarap_cli.solver.quaternion import IDENTITY, from_axis_angle, to_matrix
 
 rng = np.random.default_rng(7)
 

@@ -6,10 +6,10 @@ import pytest
 from helpers import diagonal, ends, tube, twist
 
 from srarap_cli import Deformer
-from srarap_cli.drivers.anderson import ROUNDING
-from srarap_cli.multires import MultiresDeformer
-from srarap_cli.multires.correction import CoarseCorrection
-from srarap_cli.quaternion import align_hemisphere
+from srarap_cli.solver.drivers.anderson import ROUNDING
+from srarap_cli.solver.multires import MultiresDeformer
+from srarap_cli.solver.multires.correction import CoarseCorrection
+from srarap_cli.solver.quaternion import align_hemisphere
 
 
 @pytest.fixture(scope="module")
@@ -84,7 +84,7 @@ def test_the_plain_iteration_is_never_corrected(twisted_bar):
 def test_a_coarse_mesh_above_the_threshold_is_solved_through_a_coarser_one(monkeypatch):
     """Three levels (thresholds lowered so that a test-sized mesh needs them): the middle
     level is itself coarse-to-fine and corrected, and the answer is still the direct one."""
-    from srarap_cli.multires import size
+    from srarap_cli.solver.multires import size
 
     monkeypatch.setattr(size, "AUTO_THRESHOLD", 400)
     monkeypatch.setattr(size, "AUTO_SIZE", 100)

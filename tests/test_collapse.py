@@ -3,9 +3,9 @@ import igl
 import numpy as np
 import pytest
 
-from srarap_cli.multires.collapse import collapse_to
-from srarap_cli.multires.simplify import _octahedron
-from srarap_cli.multires.topology import topology_summary
+from srarap_cli.solver.multires.collapse import collapse_to
+from srarap_cli.solver.multires.simplify import _octahedron
+from srarap_cli.solver.multires.topology import topology_summary
 
 
 def grid(k):

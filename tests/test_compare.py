@@ -8,9 +8,9 @@ from click.testing import CliRunner
 from helpers import tube_mesh
 
 from srarap_cli.cli import main
-from srarap_cli.compare import compare_meshes
-from srarap_cli.mesh_io import write_mesh
-from srarap_cli.mesh_io.mesh import Mesh
+from srarap_cli.io.mesh import write_mesh
+from srarap_cli.io.mesh.mesh import Mesh
+from srarap_cli.tasks.compare import compare_meshes
 
 
 def tri_mesh(V, F):

@@ -7,7 +7,7 @@ from helpers import ends, random_rotation, symmetric_tube, tube
 from scipy.spatial.transform import Rotation
 
 from srarap_cli import Deformer, deform
-from srarap_cli.quaternion import IDENTITY, from_axis_angle, multiply, to_matrix
+from srarap_cli.solver.quaternion import IDENTITY, from_axis_angle, multiply, to_matrix
 
 ALPHA = 0.14
 

@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from srarap_cli.cli import main
-from srarap_cli.mesh_io import format_mesh, read_mesh
+from srarap_cli.io.mesh import format_mesh, read_mesh
 
 DOCUMENTED = {0, 2, 3, 4, 5, 6}
 MESH = tube_mesh(rings=3, segments=4)

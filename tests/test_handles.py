@@ -6,9 +6,9 @@ import pytest
 import yaml
 from helpers import tube
 
-from srarap_cli.errors import InputError
-from srarap_cli.handles import load_handles
-from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli.io.handles import load_handles
+from srarap_cli.runtime.errors import InputError
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 
 V, F = tube()
 BOTTOM = np.flatnonzero(V[:, 2] < 1e-9)

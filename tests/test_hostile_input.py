@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from helpers import tube_mesh
 
-from srarap_cli.errors import InputError
-from srarap_cli.handles import load_handles
-from srarap_cli.mesh_io import read_mesh, write_mesh
+from srarap_cli.io.handles import load_handles
+from srarap_cli.io.mesh import read_mesh, write_mesh
+from srarap_cli.runtime.errors import InputError
 
 
 def ply_header(fmt, n_vertices, n_faces, count="uchar", extra=""):
@@ -103,8 +103,8 @@ def test_a_fifo_or_device_is_refused_without_blocking(tmp_path, kind):
     os.mkfifo(fifo)
     mesh_path = tmp_path / "ok.obj"
     write_mesh(str(mesh_path), tube_mesh(rings=3, segments=5))
-    code = ("import sys\nfrom srarap_cli.errors import InputError\n"
-            "from srarap_cli.mesh_io import read_mesh\nfrom srarap_cli.handles import load_handles\n"
+    code = ("import sys\nfrom srarap_cli.runtime.errors import InputError\n"
+            "from srarap_cli.io.mesh import read_mesh\nfrom srarap_cli.io.handles import load_handles\n"
             "try:\n"
             f"    if {kind!r}.startswith('mesh'): read_mesh({str(fifo)!r})\n"
             f"    else: load_handles({str(fifo)!r}, read_mesh({str(mesh_path)!r}).vertices)\n"
@@ -156,8 +156,8 @@ def test_aliases_within_bounds_still_work(tmp_path):
 def test_a_non_finite_energy_stops_a_solve_with_a_numerical_error():
     from types import SimpleNamespace
 
-    from srarap_cli.drivers import Monitor
-    from srarap_cli.errors import NumericalError
+    from srarap_cli.runtime.errors import NumericalError
+    from srarap_cli.solver.drivers import Monitor
     m = Monitor(max_iter=5, tol=1e-6)
     with pytest.raises(NumericalError, match="non-finite"):
         m.record(SimpleNamespace(total=float("nan"), membrane=0.0, bending=0.0,
@@ -250,7 +250,7 @@ def test_two_jobs_with_one_output_are_refused(tmp_path):
 
 
 def test_a_stale_temporary_file_of_a_dead_run_is_swept(tmp_path):
-    from srarap_cli.mesh_io.commit import commit_files
+    from srarap_cli.runtime.commit import commit_files
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
                           capture_output=True, text=True).stdout.strip()
     stale = tmp_path / f".srarap-{dead}-abcd.tmp"
@@ -280,7 +280,7 @@ def test_output_bytes_do_not_depend_on_the_blas_thread_count(tmp_path):
 def test_the_library_solves_with_one_blas_thread():
     from threadpoolctl import threadpool_info
 
-    from srarap_cli.threads import single_threaded
+    from srarap_cli.runtime.threads import single_threaded
     seen = single_threaded(lambda: [i["num_threads"] for i in threadpool_info()
                                     if i["user_api"] == "blas"])()
     assert seen and set(seen) == {1}
@@ -323,7 +323,7 @@ def test_a_signal_after_the_commit_reports_what_was_written(tmp_path):
     from click.testing import CliRunner
 
     from srarap_cli.cli.common import guarded
-    from srarap_cli.mesh_io.commit import COMMITTED, commit_files
+    from srarap_cli.runtime.commit import COMMITTED, commit_files
 
     @click.command()
     @guarded
@@ -362,7 +362,7 @@ def test_sigterm_while_still_importing_is_one_line_and_143():
 ])
 def test_the_api_names_the_bad_argument_and_its_shape(make, message):
     from srarap_cli import deform
-    from srarap_cli.multires.simplify import _octahedron
+    from srarap_cli.solver.multires.simplify import _octahedron
     V, F = _octahedron()
     args = dict(V=V, F=F, constrained=[0, 1], targets=V[[0, 1]])
     args.update(make(V, F))

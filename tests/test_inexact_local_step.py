@@ -4,10 +4,10 @@ import pytest
 import scipy.sparse.linalg as spla
 from helpers import ends, tube
 
-import srarap_cli.local_step.rotor_system as rotor_system
-import srarap_cli.step as step_module
+import srarap_cli.solver.local_step.rotor_system as rotor_system
+import srarap_cli.solver.step as step_module
 from srarap_cli import Deformer
-from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 
 
 @pytest.fixture(scope="module")

@@ -3,8 +3,9 @@ import numpy as np
 import scipy.sparse as sp
 from helpers import ends, tube
 
-from srarap_cli import Deformer, linalg
-from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli import Deformer
+from srarap_cli.solver import linalg
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 
 
 def test_nested_dissection_back_end_solves_spd_systems(monkeypatch):
@@ -46,7 +47,8 @@ def test_nested_dissection_back_end_is_deterministic_across_processes():
     script = (
         "import sys, hashlib; sys.path.insert(0, 'tests')\n"
         "from helpers import ends, tube\n"
-        "from srarap_cli import Deformer, linalg\n"
+        "from srarap_cli import Deformer\n"
+        "from srarap_cli.solver import linalg\n"
         "linalg.LARGE = 0\n"
         "V, F = tube(length=10.0, rings=30, segments=16)\n"
         "ids = ends(V, 10.0)\n"

@@ -2,10 +2,10 @@
 import numpy as np
 from helpers import tube
 
-from srarap_cli.local_step.membrane import membrane_matrices
-from srarap_cli.operators import cell_graph
-from srarap_cli.quaternion import multiply
-from srarap_cli.rest_edges import RestEdges
+from srarap_cli.solver.local_step.membrane import membrane_matrices
+from srarap_cli.solver.operators import cell_graph
+from srarap_cli.solver.quaternion import multiply
+from srarap_cli.solver.rest_edges import RestEdges
 
 
 def pure(v):

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 from helpers import ROOT, SHARED, needs_shared, tube_mesh
 
-from srarap_cli.errors import InputError
-from srarap_cli.mesh_io import format_mesh, read_mesh, write_mesh
-from srarap_cli.mesh_io.normals import recompute_normals
-from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli.io.mesh import format_mesh, read_mesh, write_mesh
+from srarap_cli.io.mesh.normals import recompute_normals
+from srarap_cli.runtime.errors import InputError
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 
 
 def same_structure(a, b):
@@ -91,7 +91,7 @@ def test_output_bytes_are_deterministic(tmp_path):
 @pytest.mark.parametrize("newline", ["\n", "\r\n"])
 def test_bulk_obj_reading_and_writing_match_the_line_by_line_ones(newline):
     """Plain v/f files take a bulk path both ways; it must give what the general one does."""
-    from srarap_cli.mesh_io import obj
+    from srarap_cli.io.mesh import obj
 
     spot = read_mesh(os.path.join(ROOT, "sample_meshes", "spot.obj"))
     spot.uv = spot.face_uv = spot.normals = spot.face_normals = None

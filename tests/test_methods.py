@@ -5,11 +5,11 @@ import pytest
 from helpers import ends, tube
 
 from srarap_cli import Deformer, deform
-from srarap_cli.local_step import METHODS
-from srarap_cli.local_step.linear_sym import symmetric_weights
-from srarap_cli.local_step.membrane import membrane_matrices
-from srarap_cli.local_step.relax import best_unit_rotor, colour_classes
-from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli.solver.local_step import METHODS
+from srarap_cli.solver.local_step.linear_sym import symmetric_weights
+from srarap_cli.solver.local_step.membrane import membrane_matrices
+from srarap_cli.solver.local_step.relax import best_unit_rotor, colour_classes
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 
 V, F = tube()
 IDS = ends(V)

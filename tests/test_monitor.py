@@ -3,7 +3,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from srarap_cli.drivers.monitor import EXACT, WINDOW, Monitor
+from srarap_cli.solver.drivers.monitor import EXACT, WINDOW, Monitor
 
 
 def run(energies, *, tol=1e-6, moves=None, energy_scale=1.0):

@@ -7,22 +7,22 @@ from click.testing import CliRunner
 from helpers import ROOT, SHARED, needs_shared, random_rotation, torus, tube
 
 from srarap_cli.cli import main
-from srarap_cli.group_rotations import group_rotors
-from srarap_cli.handles import load_handles
-from srarap_cli.mesh_io import read_mesh
-from srarap_cli.multires import (
+from srarap_cli.io.handles import load_handles
+from srarap_cli.io.mesh import read_mesh
+from srarap_cli.solver.group_rotations import group_rotors
+from srarap_cli.solver.multires import (
     MultiresDeformer,
     coarse_size,
     parse_size,
     simplify_to_subset,
 )
-from srarap_cli.multires.cache import coarse_mesh
-from srarap_cli.multires.dirichlet import DirichletSolver
-from srarap_cli.multires.topology import topology_summary
-from srarap_cli.multires.transfer import spread_rotors
-from srarap_cli.operators import cell_graph, mesh_area
-from srarap_cli.pipeline import problem
-from srarap_cli.quaternion import rotate, to_matrix
+from srarap_cli.solver.multires.cache import coarse_mesh
+from srarap_cli.solver.multires.dirichlet import DirichletSolver
+from srarap_cli.solver.multires.topology import topology_summary
+from srarap_cli.solver.multires.transfer import spread_rotors
+from srarap_cli.solver.operators import cell_graph, mesh_area
+from srarap_cli.solver.quaternion import rotate, to_matrix
+from srarap_cli.tasks.pipeline import problem
 
 SPOT = os.path.join(ROOT, "sample_meshes", "spot.obj")
 NOD = os.path.join(ROOT, "configs", "spot-nod.yaml")
@@ -238,7 +238,7 @@ def test_region_of_interest_moves_every_handle_vertex_and_nothing_outside(tmp_pa
 def test_every_method_runs_through_multires_and_keeps_a_translation_exact(method):
     import igl
 
-    from srarap_cli.multires.simplify import _octahedron
+    from srarap_cli.solver.multires.simplify import _octahedron
     V, F = igl.loop(*igl.loop(*_octahedron()))
     d = MultiresDeformer(V, F, np.arange(6), size=30, method=method)
     r = d.solve(V[:6] + [0.5, -1.0, 2.0], max_iter=20)
@@ -249,7 +249,7 @@ def test_every_method_runs_through_multires_and_keeps_a_translation_exact(method
 def test_parts_without_handles_stay_at_rest_with_the_same_warning_as_a_direct_solve():
     import igl
 
-    from srarap_cli.multires.simplify import _octahedron
+    from srarap_cli.solver.multires.simplify import _octahedron
     V, F = igl.loop(*igl.loop(*igl.loop(*_octahedron())))
     n = len(V)
     V2, F2 = np.vstack([V, V + [5, 0, 0]]), np.vstack([F, F + n])
@@ -267,8 +267,8 @@ def test_one_fine_factorization_serves_transfer_and_final_solve_for_every_pose(
     (its own factorizations) from the prolonged coarse result and needs none."""
     import igl
 
-    from srarap_cli.multires import deformer as module
-    from srarap_cli.multires.simplify import _octahedron
+    from srarap_cli.solver.multires import deformer as module
+    from srarap_cli.solver.multires.simplify import _octahedron
     built = []
     real = module.DirichletSolver
     monkeypatch.setattr(module, "DirichletSolver", lambda *a: built.append(1) or real(*a))

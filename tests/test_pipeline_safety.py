@@ -9,7 +9,7 @@ import sys
 import pytest
 from helpers import ROOT, stderr_on_a_terminal, tube_mesh
 
-from srarap_cli.mesh_io import write_mesh
+from srarap_cli.io.mesh import write_mesh
 
 HANDLES = ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
            "  tip: {box: {min: [-2, -2, 5.99], max: [2, 2, 6.01]}, rotate: "

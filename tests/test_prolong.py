@@ -3,11 +3,11 @@ import numpy as np
 from helpers import ends, random_rotation, tube, twist
 
 from srarap_cli import Deformer
-from srarap_cli.multires import MultiresDeformer
-from srarap_cli.multires.prolong import nearest_coarse, prolong
-from srarap_cli.operators import cell_graph
-from srarap_cli.quaternion import to_matrix
-from srarap_cli.rest_edges import RestEdges
+from srarap_cli.solver.multires import MultiresDeformer
+from srarap_cli.solver.multires.prolong import nearest_coarse, prolong
+from srarap_cli.solver.operators import cell_graph
+from srarap_cli.solver.quaternion import to_matrix
+from srarap_cli.solver.rest_edges import RestEdges
 
 
 def test_nearest_coarse_vertex_follows_the_edges_not_the_straight_line():

@@ -1,7 +1,7 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from srarap_cli.quaternion import (
+from srarap_cli.solver.quaternion import (
     from_axis_angle,
     multiply,
     normalize,

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 from helpers import ROOT
 
-from srarap_cli.handles import load_handles
-from srarap_cli.mesh_io import read_mesh
+from srarap_cli.io.handles import load_handles
+from srarap_cli.io.mesh import read_mesh
 
 
 def test_readme_handle_example_loads(tmp_path):

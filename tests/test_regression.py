@@ -8,9 +8,9 @@ from click.testing import CliRunner
 from helpers import ROOT
 
 from srarap_cli.cli import main
-from srarap_cli.handles import load_handles
-from srarap_cli.mesh_io import read_mesh
-from srarap_cli.quaternion import from_axis_angle, to_matrix
+from srarap_cli.io.handles import load_handles
+from srarap_cli.io.mesh import read_mesh
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 
 HERE = os.path.join(ROOT, "tests", "regression")
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")

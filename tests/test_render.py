@@ -9,10 +9,10 @@ from helpers import ROOT, tube_mesh
 from matplotlib.image import imread
 
 from srarap_cli.cli import main
-from srarap_cli.distortion import vertex_distortion
-from srarap_cli.mesh_io import write_mesh
-from srarap_cli.quaternion import from_axis_angle, to_matrix
-from srarap_cli.render import PALETTE
+from srarap_cli.io.mesh import write_mesh
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
+from srarap_cli.tasks.distortion import vertex_distortion
+from srarap_cli.tasks.render import PALETTE
 
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
 BEND = os.path.join(ROOT, "configs", "bar-bend.yaml")

@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 from helpers import torus
 
-from srarap_cli import operators
-from srarap_cli.energy import bending_energy
-from srarap_cli.operators import cell_graph
-from srarap_cli.quaternion import to_matrix
-from srarap_cli.rest_edges import RestEdges
+from srarap_cli.solver import operators
+from srarap_cli.solver.energy import bending_energy
+from srarap_cli.solver.operators import cell_graph
+from srarap_cli.solver.quaternion import to_matrix
+from srarap_cli.solver.rest_edges import RestEdges
 
 
 @pytest.fixture

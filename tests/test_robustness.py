@@ -12,7 +12,7 @@ from click.testing import CliRunner
 from helpers import ROOT, tube_mesh
 
 from srarap_cli.cli import main
-from srarap_cli.mesh_io import read_mesh
+from srarap_cli.io.mesh import read_mesh
 
 BASE = {"box": {"min": [-2, -2, -0.01], "max": [2, 2, 0.01]}, "fixed": True}
 TIP = {"box": {"min": [-2, -2, 5.99], "max": [2, 2, 6.01]}, "translate": [1.0, 0, 0]}

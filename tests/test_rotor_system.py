@@ -3,11 +3,11 @@ import numpy as np
 import scipy.sparse as sp
 from helpers import torus
 
-from srarap_cli.local_step import rotor_system
-from srarap_cli.local_step.linear_sym import SymmetricRotorStep
-from srarap_cli.local_step.rotor_system import FreeRotorMatrix
-from srarap_cli.operators import cell_graph
-from srarap_cli.rest_edges import RestEdges
+from srarap_cli.solver.local_step import rotor_system
+from srarap_cli.solver.local_step.linear_sym import SymmetricRotorStep
+from srarap_cli.solver.local_step.rotor_system import FreeRotorMatrix
+from srarap_cli.solver.operators import cell_graph
+from srarap_cli.solver.rest_edges import RestEdges
 
 
 def test_product_and_assembly_equal_the_dense_block_matrix():

@@ -9,13 +9,13 @@ from helpers import ends, tube
 
 from srarap_cli import Deformer, deform
 from srarap_cli.cli import main
-from srarap_cli.drivers import DRIVERS, register
-from srarap_cli.errors import InputError
-from srarap_cli.handles import load_handles
-from srarap_cli.quaternion import from_axis_angle, to_matrix
-from srarap_cli.settings import SETTINGS, parse_mapping
-from srarap_cli.starts import STARTS
-from srarap_cli.starts import register as register_start
+from srarap_cli.io.handles import load_handles
+from srarap_cli.runtime.errors import InputError
+from srarap_cli.solver.drivers import DRIVERS, register
+from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
+from srarap_cli.solver.settings import SETTINGS, parse_mapping
+from srarap_cli.solver.starts import STARTS
+from srarap_cli.solver.starts import register as register_start
 
 
 @pytest.fixture(scope="module")

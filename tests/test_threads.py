@@ -3,7 +3,7 @@ import threading
 
 import pytest
 
-from srarap_cli.threads import background
+from srarap_cli.runtime.threads import background
 
 
 def test_background_returns_the_result_computed_in_another_thread():

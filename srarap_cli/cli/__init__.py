@@ -8,8 +8,8 @@ import sys
 
 import click
 
-from .. import signals
-from ..threads import pin_process
+from ..runtime import signals
+from ..runtime.threads import pin_process
 
 #: name -> (module, function, one-line help shown by ``srarap --help``)
 COMMANDS = {

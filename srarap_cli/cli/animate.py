@@ -8,15 +8,16 @@ import time
 
 import click
 
-from ..animation import FRAME_FIELDS, Animator, FrameState, fingerprint
-from ..errors import InputError, OutputError
-from ..handles import load_handles
-from ..limits import check_solve
-from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
-from ..mesh_io.commit import commit_files
-from ..settings import click_options, resolve
-from ..solve_log import LOG_FORMATS, format_log
+from ..io.handles import load_handles
+from ..io.mesh import WRITE_FORMATS, format_mesh, read_mesh
+from ..io.solve_log import LOG_FORMATS, format_log
+from ..runtime.commit import commit_files
+from ..runtime.errors import InputError, OutputError
+from ..runtime.limits import check_solve
+from ..solver.settings import resolve
+from ..tasks.animation import FRAME_FIELDS, Animator, FrameState, fingerprint
 from .common import cache_option, check_output_path, guarded
+from .options import settings_options
 
 STATE_NAME = ".srarap-animate-state.npz"
 
@@ -34,7 +35,7 @@ STATE_NAME = ".srarap-animate-state.npz"
               help="Local/global iterations per frame at most.")
 @click.option("--log", "log", help="Per-frame log: .csv or .jsonl.")
 @click.option("--resume", is_flag=True, help="Continue after the last complete frame.")
-@click_options(exclude=("time_limit",))
+@settings_options(exclude=("time_limit",))
 @cache_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress, summary or warnings.")
 @guarded
@@ -66,7 +67,7 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, o
         commit_files([(pattern.format(f), data), (state_path, st.to_bytes())])
         progress.update(f + 1)
 
-    final = animator.run(n_frames, iters_per_frame=iters_per_frame, tol=opts["tol"],
+    final = animator.run(n_frames, iters_per_frame=iters_per_frame, tol=opts.tol,
                          state=state, on_frame=write_frame, fingerprint=run_id)
     progress.close()
     rows = final.rows if final is not None else []

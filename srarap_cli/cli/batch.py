@@ -6,10 +6,10 @@ import os
 
 import click
 
-from .. import exit_codes
-from ..batch import SUMMARY_FIELDS, check_outputs, load_manifest, run_batch
-from ..errors import OutputError
-from ..mesh_io.commit import commit_files
+from ..runtime import exit_codes
+from ..runtime.commit import commit_files
+from ..runtime.errors import OutputError
+from ..tasks.batch import SUMMARY_FIELDS, check_outputs, load_manifest, run_batch
 from .common import guarded
 
 

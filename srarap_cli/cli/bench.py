@@ -3,16 +3,17 @@ import os
 
 import click
 
-from ..bench import ALL_METHODS, IGL, run_methods
-from ..bench_report import curves_csv, plot_png, summary_json, table
-from ..errors import OutputError
-from ..handles import load_handles
-from ..limits import check_solve
-from ..mesh_io import read_mesh
-from ..mesh_io.commit import commit_files
-from ..pipeline import problem
-from ..settings import click_options, resolve
+from ..io.handles import load_handles
+from ..io.mesh import read_mesh
+from ..runtime.commit import commit_files
+from ..runtime.errors import OutputError
+from ..runtime.limits import check_solve
+from ..solver.settings import resolve
+from ..tasks.bench import ALL_METHODS, IGL, run_methods
+from ..tasks.bench_report import curves_csv, plot_png, summary_json, table
+from ..tasks.pipeline import problem
 from .common import guarded
+from .options import settings_options
 
 CHOICES = ALL_METHODS + (IGL,)
 # bench measures how fast each method approaches the minimum, so it runs far past the usual
@@ -29,7 +30,7 @@ OWN_DEFAULTS = {"tol": 1e-9, "max_iter": 100000}
               show_default=True, help="Seconds each method may run.")
 @click.option("-o", "--output", "out", type=click.Path(file_okay=False),
               help="Folder for curves.csv, summary.json and energy.png (created if missing).")
-@click_options(exclude=("method", "multires", "multires_mode", "time_limit", "accel", "start"),
+@settings_options(exclude=("method", "multires", "multires_mode", "time_limit", "accel", "start"),
                defaults=OWN_DEFAULTS)
 @guarded
 def bench(mesh, handles, methods, time_budget, out, overrides):
@@ -54,12 +55,12 @@ def bench(mesh, handles, methods, time_budget, out, overrides):
     p = problem(source, constraints, mesh)
     runs = run_methods(p.V, p.F, p.ids, p.targets, names, settings=opts,
                        time_budget=time_budget, max_iter=stop["max_iter"], tol=stop["tol"],
-                       sweeps=opts["sweeps"])
+                       sweeps=opts.sweeps)
     click.echo(table(runs), nl=False)
     if out is not None:
         info = {"mesh": mesh, "handles": handles, "vertices": len(p.V),
                 "constrained": len(p.ids), "time_budget": time_budget,
-                **{k: opts[k] for k in ("alpha", "feedback", "weights", "sweeps")}}
+                **{k: getattr(opts, k) for k in ("alpha", "feedback", "weights", "sweeps")}}
         title = f"{os.path.basename(mesh)} ({len(p.V)} vertices)"
         commit_files([(os.path.join(out, "curves.csv"), curves_csv(runs).encode()),
                       (os.path.join(out, "summary.json"), summary_json(runs, info).encode()),

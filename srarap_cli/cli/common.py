@@ -7,10 +7,10 @@ import traceback
 import click
 import numpy as np
 
-from .. import exit_codes, signals
-from ..errors import InputError, NumericalError, OutputError, SingularSystemError
-from ..mesh_io.commit import COMMITTED
-from ..signals import Terminated
+from ..runtime import exit_codes, signals
+from ..runtime.commit import COMMITTED
+from ..runtime.errors import InputError, NumericalError, OutputError, SingularSystemError
+from ..runtime.signals import Terminated
 
 
 def fail(code, message):

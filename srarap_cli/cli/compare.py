@@ -3,10 +3,10 @@ import json
 
 import click
 
-from .. import exit_codes
-from ..compare import compare_meshes
-from ..mesh_io import read_mesh
-from ..mesh_io.commit import commit_files
+from ..io.mesh import read_mesh
+from ..runtime import exit_codes
+from ..runtime.commit import commit_files
+from ..tasks.compare import compare_meshes
 from .common import check_output_path, guarded
 
 

@@ -6,20 +6,21 @@ import tempfile
 
 import click
 
-from .. import exit_codes
-from ..distortion import vertex_distortion
-from ..drivers.monitor import recent_changes
-from ..errors import InputError
-from ..handles import load_handles
-from ..limits import check_solve
-from ..mesh_io import WRITE_FORMATS, format_mesh, read_mesh
-from ..mesh_io.commit import commit_files
-from ..multires.size import AUTO_THRESHOLD
-from ..pipeline import deform_mesh
-from ..preview import preview_png
-from ..settings import click_options, complete, resolve
-from ..solve_log import LOG_FORMATS, format_log
+from ..io.handles import load_handles
+from ..io.mesh import WRITE_FORMATS, format_mesh, read_mesh
+from ..io.solve_log import LOG_FORMATS, format_log
+from ..runtime import exit_codes
+from ..runtime.commit import commit_files
+from ..runtime.errors import InputError
+from ..runtime.limits import check_solve
+from ..solver.drivers.monitor import recent_changes
+from ..solver.multires.size import AUTO_THRESHOLD
+from ..solver.settings import complete, resolve
+from ..tasks.distortion import vertex_distortion
+from ..tasks.pipeline import deform_mesh
+from ..tasks.preview import preview_png
 from .common import cache_option, check_output_path, guarded
+from .options import settings_options
 from .progress import SolveProgress
 
 
@@ -35,7 +36,7 @@ from .progress import SolveProgress
               help="Format of the output when it is '-' (standard output).")
 @click.option("--log", "log",
               help="Per-iteration energy log: .csv or .jsonl.")
-@click_options()
+@settings_options()
 @cache_option
 @click.option("--preview", help="Also write a PNG: rest and deformed shape, handles coloured.")
 @click.option("--preview-up", type=click.Choice(["y", "z", "x", "-y", "-z", "-x"]), default="y",
@@ -69,16 +70,16 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
     name = "<stdin>" if mesh == "-" else mesh
     check_solve(name, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
+    opts = resolve(constraints.solver, overrides)
     progress = SolveProgress(enabled=not quiet and sys.stderr.isatty())
     try:
         deformed, result, notes = deform_mesh(source, constraints, callback=progress,
-                                              cache=cache, name=name, **overrides)
+                                              cache=cache, name=name, settings=opts)
     finally:
         progress.close()
     if write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
-    opts = resolve(constraints.solver, overrides)
     done = complete(result, opts)
     mesh_bytes, lost = format_mesh(deformed, suffix)
     keep = done or keep_unconverged
@@ -151,24 +152,24 @@ def _why(log, opts):
     if not changes:
         return "no iteration ran"
     mean = sum(changes) / len(changes)
-    if mean > opts["tol"]:
+    if mean > opts.tol:
         return (f"relative change {mean:.3g} per step over the last {len(changes)} > "
-                f"tol {opts['tol']:g}")
+                f"tol {opts.tol:g}")
     return (f"relative change {mean:.3g} per step but the last step still moved a vertex by "
             f"{log[-1]['max_move']:.3g}")
 
 
 def _advice(result, opts):
     """What to try after a run that stopped unconverged, from how it stopped."""
-    if opts["time_limit"] is not None and result.seconds >= opts["time_limit"]:
-        return f"stopped by --time-limit {opts['time_limit']:g}: allow more time"
-    tips = [f"raise --max-iter (was {opts['max_iter']})"]
+    if opts.time_limit is not None and result.seconds >= opts.time_limit:
+        return f"stopped by --time-limit {opts.time_limit:g}: allow more time"
+    tips = [f"raise --max-iter (was {opts.max_iter})"]
     n = len(result.positions)
-    if opts["multires"] == "off" and n >= AUTO_THRESHOLD:
+    if opts.multires == "off" and n >= AUTO_THRESHOLD:
         tips.append(f"--multires auto (a coarse solve starts the {n} vertices closer)")
-    if opts["accel"] == "none":
+    if opts.accel == "none":
         tips.append("use --accel anderson")
-    if opts["start"] == "laplacian":
+    if opts.start == "laplacian":
         tips.append("--start harmonic")
     last = result.log[-1]["rel_change"]
     if not math.isnan(last):

@@ -6,11 +6,11 @@ import os
 import click
 import numpy as np
 
-from ..handles import load_handles
-from ..mesh_io import read_mesh
-from ..mesh_io.commit import commit_files
-from ..preview import preview_png
-from ..render import VIEWS
+from ..io.handles import load_handles
+from ..io.mesh import read_mesh
+from ..runtime.commit import commit_files
+from ..tasks.preview import preview_png
+from ..tasks.render import VIEWS
 from .common import check_output_path, guarded
 
 
@@ -109,8 +109,8 @@ def plot(logs, out, size):
 
 
 def _read_log(path):
-    from ..errors import InputError
-    from ..input_files import open_input
+    from ..io.input_files import open_input
+    from ..runtime.errors import InputError
     try:
         with open_input(path, encoding="utf-8") as fh:
             if path.lower().endswith(".csv"):

@@ -1,0 +1,66 @@
+"""Click options built from the one settings table (:data:`srarap_cli.solver.settings.SETTINGS`).
+
+The solver's settings module knows nothing of Click; this is the only place the table becomes
+command-line flags.
+"""
+import functools
+import math
+
+import click
+
+from ..solver.multires.size import parse_size
+from ..solver.settings import SETTINGS, Setting
+
+
+def setting_option(setting: Setting, default=None):
+    """The Click option of one setting; its value is None unless given (the handle file and
+    the defaults fill in). ``default`` replaces the shown default where a command has its own."""
+    shown = setting.default if default is None else default
+    text = f"{setting.help} [default: {'none' if shown is None else shown}]"
+    if setting.kind == "choice":
+        kind, callback = click.Choice(setting.choices), None
+    elif setting.kind == "size":
+        return click.option(setting.flag, callback=_size_option, metavar=setting.metavar,
+                            help=text)
+    elif setting.kind == "int":
+        kind, callback = click.IntRange(min=setting.minimum, min_open=setting.strict), None
+    else:
+        kind = click.FloatRange(min=setting.minimum, min_open=setting.strict)
+        callback = _finite_option
+    return click.option(setting.flag, setting.name, type=kind, metavar=setting.metavar,
+                        help=text, callback=callback)
+
+
+def _finite_option(_ctx, _param, value):
+    if value is not None and not math.isfinite(value):
+        raise click.BadParameter("must be a finite number")
+    return value
+
+
+def _size_option(_ctx, _param, value):
+    if value is None:
+        return None
+    try:
+        return parse_size(value)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+def settings_options(*, exclude=(), defaults=None):
+    """Decorator: one Click option per setting (bar ``exclude``); the command receives them
+    together as ``overrides``, a dict of name -> value or None. ``defaults`` replaces the
+    shown default where a command has its own (``bench``'s ``tol``)."""
+    chosen = [s for s in SETTINGS if s.name not in exclude]
+    defaults = defaults or {}
+
+    def decorate(func):
+        @functools.wraps(func)
+        def wrapper(*args, **kwargs):
+            overrides = {s.name: kwargs.pop(s.name) for s in chosen}
+            return func(*args, overrides=overrides, **kwargs)
+
+        for s in reversed(chosen):
+            wrapper = setting_option(s, defaults.get(s.name))(wrapper)
+        return wrapper
+
+    return decorate

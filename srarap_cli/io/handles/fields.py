@@ -1,0 +1,82 @@
+"""Typed field access for the handle file, with errors that name file, group and field."""
+import numpy as np
+
+from ...runtime.errors import InputError, excerpt
+
+#: Largest integer a handle file may hold (vertex ids and counts fit in int64 with room).
+MAX_INT = 2 ** 53
+
+
+class Context:
+    """Where a value sits in the handle file, for one-line error messages."""
+
+    def __init__(self, path, where=""):
+        self.path = path
+        self.where = where
+
+    def at(self, where):
+        return Context(self.path, where)
+
+    def error(self, message):
+        prefix = f"{self.path}: {self.where}: " if self.where else f"{self.path}: "
+        return InputError(prefix + message)
+
+    def mapping(self, value, name, allowed):
+        if not isinstance(value, dict):
+            raise self.error(f"{name} must be a mapping of keys to values")
+        unknown = sorted(set(map(str, value)) - set(allowed))
+        if unknown:
+            raise self.error(f"unknown key {excerpt(unknown[0])!r} in {name} "
+                             f"(allowed: {', '.join(sorted(allowed))})")
+        return value
+
+    def record(self, value, name, keys):
+        """A mapping with exactly ``keys``, all of them required."""
+        value = self.mapping(value, name, keys)
+        missing = [k for k in keys if k not in value]
+        if missing:
+            raise self.error(f"{name} needs " + " and ".join(f"{k!r}" for k in keys))
+        return value
+
+    def vector(self, value, name, length):
+        arr = self.numbers(value, name)
+        if arr.shape != (length,):
+            raise self.error(f"{name} must be a list of {length} numbers")
+        return arr
+
+    def matrix4(self, value, name):
+        arr = self.numbers(value, name)
+        if arr.size == 16:
+            arr = arr.reshape(4, 4)
+        if arr.shape != (4, 4):
+            raise self.error(f"{name} must be a 4x4 matrix (4 rows of 4 numbers)")
+        return arr
+
+    def numbers(self, value, name):
+        if isinstance(value, (str, bool)) or value is None:
+            raise self.error(f"{name} must be numeric")
+        try:
+            arr = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise self.error(f"{name} must be numeric") from None
+        if not np.isfinite(arr).all():
+            raise self.error(f"{name} must be finite")
+        return arr
+
+    def number(self, value, name, minimum=None, strict=False):
+        arr = self.numbers(value, name)
+        if arr.ndim != 0:
+            raise self.error(f"{name} must be a single number")
+        x = float(arr)
+        if minimum is not None and (x <= minimum if strict else x < minimum):
+            raise self.error(f"{name} must be {'>' if strict else '>='} {minimum:g}")
+        return x
+
+    def integer(self, value, name, minimum=None):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise self.error(f"{name} must be an integer")
+        if minimum is not None and value < minimum:
+            raise self.error(f"{name} must be >= {minimum}")
+        if abs(int(value)) > MAX_INT:
+            raise self.error(f"{name}: {int(value)} is out of range")
+        return int(value)

@@ -1,0 +1,53 @@
+"""Open the user's input files only when they are regular files.
+
+A FIFO, ``/dev/zero``, ``/dev/urandom`` or a socket given as a mesh or handle file would block
+forever or read without bound; the size checks that guard memory mean nothing for them. The
+file is opened without blocking and checked on the open descriptor, so nothing can swap it
+between the check and the read.
+"""
+import os
+import stat
+
+from ..runtime.errors import InputError
+
+
+def open_input(path, mode="r", **kwargs):
+    """``open(path, mode, **kwargs)`` for reading, refusing anything but a regular file.
+
+    Raises
+    ------
+    InputError : missing, a folder, not a regular file, or unreadable
+
+    Examples
+    --------
+    >>> open_input("/dev/null")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    srarap_cli.runtime.errors.InputError: /dev/null: not a regular file (...); give a file
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise InputError(f"{path}: is a folder, not a file") from None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    try:
+        kind = os.fstat(fd).st_mode
+        if stat.S_ISDIR(kind):
+            raise InputError(f"{path}: is a folder, not a file")
+        if not stat.S_ISREG(kind):
+            raise InputError(f"{path}: not a regular file (a device, FIFO or socket); give a file")
+        if hasattr(os, "set_blocking"):
+            os.set_blocking(fd, True)
+        return os.fdopen(fd, mode, **kwargs)
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def read_input_bytes(path):
+    """The whole content of a regular file (see :func:`open_input`)."""
+    with open_input(path, "rb") as fh:
+        return fh.read()

@@ -1,0 +1,136 @@
+"""Read and write meshes, keeping vertex order, polygons, UVs and normals.
+
+OBJ, OFF and PLY are parsed here (meshio fails on common variants of OBJ and OFF, and trusts
+PLY headers); STL is read with meshio. Writers are deterministic (no timestamps) and atomic (temporary file in
+the target folder, then rename), so a failed run never leaves a partial file behind.
+"""
+import io
+import os
+import struct
+import warnings
+from contextlib import redirect_stderr, redirect_stdout
+
+import numpy as np
+
+from ...runtime.commit import atomic_write
+from ...runtime.errors import InputError, OutputError
+from ...runtime.limits import check_read
+from .mesh import Mesh
+from .normals import recompute_normals
+from .obj import format_obj, read_obj
+from .off import format_off, read_off
+from .ply import format_ply, mesh_from_meshio, per_vertex
+from .ply_read import read_ply
+
+READ_FORMATS = (".obj", ".off", ".ply", ".stl")
+WRITE_FORMATS = (".obj", ".off", ".ply")
+
+__all__ = ["READ_FORMATS", "WRITE_FORMATS", "Mesh", "atomic_write", "read_mesh", "write_mesh"]
+
+
+def _suffix(path):
+    return os.path.splitext(str(path))[1].lower()
+
+
+def read_mesh(path: str | os.PathLike) -> Mesh:
+    """Read OBJ, OFF, PLY or STL into a :class:`Mesh`.
+
+    Raises
+    ------
+    InputError : the file is missing, unreadable, of another format or invalid.
+    """
+    suffix = _suffix(path)
+    if suffix not in READ_FORMATS:
+        raise InputError(f"{path}: unsupported mesh format {suffix or '(none)'!r}; "
+                         f"use one of {', '.join(READ_FORMATS)}")
+    if os.path.isdir(path):
+        raise InputError(f"{path}: is a folder, not a mesh file")
+    check_read(path)
+    try:
+        if suffix == ".obj":
+            mesh = read_obj(path)
+        elif suffix == ".off":
+            mesh = read_off(path)
+        elif suffix == ".ply":
+            mesh = read_ply(path)
+        else:
+            mesh = _read_meshio(path, suffix)
+    except InputError:
+        raise
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    _validate(mesh, path)
+    return mesh
+
+
+def _read_meshio(path, suffix):
+    import meshio  # only STL needs it; loading it costs a tenth of a second
+
+    failures = (SystemExit, meshio.ReadError, ValueError, IndexError, KeyError, EOFError,
+                TypeError, struct.error)
+    if not os.path.isfile(path):
+        raise InputError(f"{path}: no such file")
+    chatter = io.StringIO()
+    try:
+        # meshio prints its own message and calls sys.exit() on some files it cannot read
+        with warnings.catch_warnings(), redirect_stdout(chatter), redirect_stderr(chatter):
+            warnings.simplefilter("ignore")
+            m = meshio.read(path, file_format="stl")
+    except failures as exc:
+        detail = str(exc) if not isinstance(exc, SystemExit) else "unrecognized content"
+        raise InputError(f"{path}: not a readable {suffix[1:].upper()} file ({detail})") from None
+    return mesh_from_meshio(m)
+
+
+def _validate(mesh, path):
+    n = len(mesh.vertices)
+    if n == 0 or mesh.face_sizes.size == 0:
+        raise InputError(f"{path}: mesh has no {'vertices' if n == 0 else 'faces'}")
+    if not np.isfinite(mesh.vertices).all():
+        bad = int(np.flatnonzero(~np.isfinite(mesh.vertices).all(axis=1))[0])
+        raise InputError(f"{path}: vertex {bad} has a NaN or infinite coordinate")
+    fv = mesh.face_vertices
+    if fv.min() < 0 or fv.max() >= n:
+        raise InputError(f"{path}: a face references vertex "
+                         f"{int(fv.min() if fv.min() < 0 else fv.max())}, "
+                         f"but the mesh has vertices 0..{n - 1}")
+
+
+def format_mesh(mesh, suffix):
+    """File content for ``mesh`` in the format of ``suffix``, with warnings for lost data."""
+    lost = []
+    if suffix == ".obj":
+        return format_obj(mesh).encode("utf-8"), lost
+    if mesh.uv is not None and (suffix == ".off" or per_vertex(mesh, mesh.uv, mesh.face_uv) is None):
+        lost.append(f"texture coordinates not written: {suffix[1:].upper()} stores at most one "
+                    "per vertex; write .obj to keep them")
+    if mesh.normals is not None and per_vertex(mesh, mesh.normals, mesh.face_normals) is None:
+        mesh = _vertex_normals(mesh)
+    if suffix == ".off":
+        return format_off(mesh).encode("ascii"), lost
+    return format_ply(mesh), lost
+
+
+def _vertex_normals(mesh):
+    """Per-corner normals (OBJ) become per-vertex normals for formats that only have those."""
+    out = Mesh(**{k: getattr(mesh, k) for k in mesh.__dataclass_fields__})
+    out.normals = np.zeros_like(mesh.vertices)
+    out.face_normals = mesh.face_vertices
+    out.normals = recompute_normals(out)
+    return out
+
+
+def write_mesh(path: str | os.PathLike, mesh: Mesh) -> list[str]:
+    """Write ``mesh`` to ``path`` (format from the extension) atomically.
+
+    Returns
+    -------
+    list of str : warnings about data the format cannot hold
+    """
+    suffix = _suffix(path)
+    if suffix not in WRITE_FORMATS:
+        raise OutputError(f"{path}: cannot write {suffix or 'files without extension'}; "
+                          f"use one of {', '.join(WRITE_FORMATS)}")
+    data, lost = format_mesh(mesh, suffix)
+    atomic_write(path, data)
+    return lost

@@ -1,0 +1,106 @@
+"""What every driver shares: the log, the callback, the non-finite check, the stopping rules.
+
+The energy test averages the relative change over the last :data:`WINDOW` iterates: with
+acceleration the energy does not fall smoothly, and one accepted step that happens to change
+it by little said nothing about the steps around it (a refine run on the 46k Spot stopped
+0.08% above the minimum on one such step while its neighbours still gained 1e-5 each).
+(The first steps of a solve average over the steps there are: a warm start from a converged
+result stops after one.) An energy below ``tol * EXACT`` times the rest shape's scale ``sum c
+|q|^2`` is converged at once: the minimum is not below zero, so at most that much is left to
+gain (vertices within about ``sqrt(tol * EXACT)`` of the edge lengths of the answer), while the
+relative changes of an energy near rounding level are noise that may never settle.
+"""
+import time
+
+import numpy as np
+
+from ...runtime.errors import NumericalError
+
+#: iterates whose mean relative energy change is compared with ``tol``
+WINDOW = 3
+#: an energy below ``tol * EXACT`` of the rest shape's scale is an exact answer
+EXACT = 1e-6
+#: relative changes divide by at least this much of the rest shape's scale
+FLOOR = 1e-14
+
+
+def recent_changes(log):
+    """Relative energy changes of the last WINDOW steps of ``log`` after its latest start row
+    (``step`` ending in ``start``), oldest first; what the energy test averages."""
+    changes = []
+    for row in reversed(log):
+        if row["step"].endswith("start") or len(changes) == WINDOW:
+            break
+        changes.append(row["rel_change"])
+    return changes[::-1]
+
+
+class Monitor:
+    """Records accepted iterates and decides when to stop.
+
+    Parameters
+    ----------
+    max_iter : int, steps at most
+    tol : float, converged when the relative energy changes ``|E_k - E_{k-1}| / |E_{k-1}|``
+        of the last WINDOW steps average at most ``tol`` and the last step moved no vertex by
+        more than ``sqrt(tol) * scale`` (an accelerated step can change the shape a lot while
+        the energy barely changes); or when the energy is below ``tol * EXACT * energy_scale``
+    time_limit : float or None, stop (not converged) after this many seconds
+    callback : callable(dict) or None, called with each log row
+    energy_scale : float, the rest shape's ``sum c |q|^2``; relative changes divide by at
+        least ``1e-14`` of it
+    scale : float, the mesh's size (bounding-box diagonal)
+
+    Attributes
+    ----------
+    log : list of dict, one row per recorded iterate (keys ``solve_log.LOG_FIELDS``)
+    converged : bool
+    iterations : int, steps recorded after the start
+    """
+
+    def __init__(self, *, max_iter, tol, time_limit=None, callback=None, energy_scale=0.0,
+                 scale=float("inf")):
+        self.max_iter, self.tol, self.time_limit = max_iter, tol, time_limit
+        self.move_tol = np.sqrt(max(tol, 0.0)) * scale
+        self.callback = callback
+        self.energy_floor = FLOOR * energy_scale
+        self.exact_energy = max(tol, 0.0) * EXACT * energy_scale
+        self.log = []
+        self.converged = False
+        self.start = time.perf_counter()
+
+    @property
+    def iterations(self):
+        return max(len(self.log) - 1, 0)
+
+    def record(self, state, previous=None, kind=None):
+        """Log ``state`` (``previous``: the iterate it came from, None for the start;
+        ``kind``: how the driver made it, default ``start`` or ``plain``); returns True
+        when the solve should stop."""
+        total = state.total
+        if not np.isfinite(total):
+            raise NumericalError(f"energy became non-finite at iteration {len(self.log)}")
+        if previous is None:
+            rel, move = float("nan"), 0.0
+        else:
+            last = self.log[-1]["total"]
+            rel = abs(total - last) / max(abs(last), self.energy_floor)
+            d = state.positions - previous.positions
+            move = float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d), initial=0.0)))
+        row = {"iteration": len(self.log), "membrane": state.membrane,
+               "bending": state.bending, "total": total, "rel_change": rel,
+               "max_move": move, "seconds": time.perf_counter() - self.start,
+               "step": kind or ("start" if previous is None else "plain")}
+        self.log.append(row)
+        if self.callback is not None:
+            self.callback(row)
+        if previous is None:
+            return self.max_iter <= 0
+        changes = recent_changes(self.log)
+        settled = sum(changes) <= len(changes) * self.tol
+        exact = abs(total) < self.exact_energy
+        if (settled or exact) and move <= self.move_tol:
+            self.converged = True
+            return True
+        timed_out = self.time_limit is not None and row["seconds"] >= self.time_limit
+        return timed_out or self.iterations >= self.max_iter

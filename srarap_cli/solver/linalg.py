@@ -1,0 +1,101 @@
+"""Sparse factorizations shared by the Poisson solve and the rotor systems' preconditioner."""
+import hashlib
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..runtime.errors import SingularSystemError
+
+# Above this size SuperLU's minimum-degree ordering is what takes the time (on the 738k-vertex
+# Laplacian it had not finished after 12 minutes). METIS's nested dissection orders it in 7 s
+# and SuperLU then factors it in 6.6 s (80M entries), where libigl's Cholesky (Eigen, AMD)
+# took 31 s and its 4-column solves were twice as slow as SuperLU's (0.21 against 0.10 s at
+# 184k vertices). Below, minimum degree is as good or better (46k: 0.38 s factor, 24 ms solve;
+# nested dissection 0.55 s, 23 ms).
+LARGE = 200_000
+
+
+def factor(A, symmetric):
+    """LU-factor a sparse square matrix; returns a callable ``solve(b)``.
+
+    A symmetric matrix gets a symmetric fill-reducing ordering, which roughly halves the
+    fill of SuperLU's default column ordering on mesh Laplacians, and SuperLU's symmetric
+    mode (diagonal pivots preferred): with the same fill, its triangular solves ran 1.5 to 4
+    times faster on the benchmark meshes (decimated-max Laplacian: 2.0 -> 0.5 ms).
+
+    Parameters
+    ----------
+    A : (n, n) sparse matrix
+    symmetric : bool
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> solve = factor(sp.csr_matrix(np.array([[2.0, 1], [1, 3]])), symmetric=True)
+    >>> np.allclose(solve(np.array([3.0, 4])), [1, 1])
+    True
+    """
+    if symmetric and A.shape[0] > LARGE:
+        return _nested_dissection(A)
+    options = {"SymmetricMode": True} if symmetric else {}
+    try:
+        lu = spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A" if symmetric else "COLAMD",
+                       options=options)
+    except RuntimeError as exc:  # SuperLU reports an exactly singular matrix this way
+        raise SingularSystemError(str(exc)) from exc
+    return lu.solve
+
+
+def _nested_dissection(A):
+    """SuperLU of a symmetric ``A`` in METIS's nested dissection order: ``solve(b)``."""
+    order = fill_order(A)
+    permuted = sp.csc_matrix(sp.csr_matrix(A)[order][:, order])
+    try:
+        lu = spla.splu(permuted, permc_spec="NATURAL", options={"SymmetricMode": True})
+    except RuntimeError as exc:
+        raise SingularSystemError(str(exc)) from exc
+
+    def solve(b):
+        B = np.asarray(b, dtype=float)
+        out = np.empty_like(B)
+        out[order] = lu.solve(np.ascontiguousarray(B[order]))
+        return out
+
+    return solve
+
+
+# the Poisson matrix and the rotor preconditioner share their pattern among the free
+# vertices: one nested dissection serves both (3.5 s at 738k vertices)
+_ORDERS = {}
+
+
+def fill_order(A):
+    """METIS nested dissection order of the graph of a symmetric sparse matrix's stored
+    off-diagonal entries (explicit zeros count); vertices without any come first. METIS runs
+    once per pattern of the others: a second matrix with the same pattern reuses its order.
+
+    Parameters
+    ----------
+    A : (n, n) sparse matrix
+
+    Returns
+    -------
+    (n,) int64 array, a permutation of ``range(n)``
+    """
+    import pymetis
+
+    coo = sp.coo_matrix(A)
+    off = coo.row != coo.col
+    graph = sp.csr_matrix((np.ones(off.sum()), (coo.row[off], coo.col[off])), shape=A.shape)
+    linked = np.diff(graph.indptr) > 0
+    ids = np.flatnonzero(linked)
+    sub = graph[ids][:, ids]
+    sub.sort_indices()
+    key = hashlib.sha256(sub.indptr.astype(np.int64).tobytes()
+                         + sub.indices.astype(np.int64).tobytes()).hexdigest()
+    if key not in _ORDERS:
+        _ORDERS.clear()
+        _ORDERS[key] = np.asarray(pymetis.nested_dissection(
+            pymetis.CSRAdjacency(sub.indptr, sub.indices))[0], dtype=np.int64)
+    return np.concatenate([np.flatnonzero(~linked), ids[_ORDERS[key]]])

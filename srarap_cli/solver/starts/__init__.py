@@ -1,0 +1,16 @@
+"""Starts: how the first iterate of a solve is made.
+
+A start is ``start(step, initial) -> State`` with ``step`` the solve's
+:class:`~srarap_cli.solver.step.LocalGlobalStep` and ``initial`` the caller's ``(positions, rotors)``
+or None. :data:`STARTS` maps names to starts; :func:`register` adds one.
+"""
+from .harmonic import harmonic_start
+from .laplacian import laplacian_start
+from .warm import warm_start
+
+STARTS = {"harmonic": harmonic_start, "laplacian": laplacian_start, "warm": warm_start}
+
+
+def register(name, start):
+    """Make ``start`` available as ``Deformer.solve(..., start=name)``."""
+    STARTS[name] = start

@@ -1,0 +1,241 @@
+"""Many deformations from one manifest: up-to-date checks, parallel workers, a summary.
+
+A manifest (YAML or JSON) lists jobs; paths are relative to the manifest::
+
+    defaults: {method: sr-linear-sym, tol: 1.0e-6}      # solver settings for every job
+    jobs:
+      - name: bar-twist
+        mesh: ../sample_meshes/bar.obj
+        handles: ../configs/bar-twist.yaml
+        output: bar-twist.obj                           # relative to the output folder
+        settings: {max_iter: 500}                       # this job only
+        expect: {golden: golden/bar-twist.obj, tol: 1.0e-9, relative: true}
+
+A job is up to date when its output exists and the sidecar ``<output>.srarap.json`` records
+the same fingerprint (content of the mesh, the handle file and every file it names, settings,
+srarap version).
+"""
+import hashlib
+import json
+import math
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from importlib import metadata
+
+from ..io.documents import load_document
+from ..io.handles import load_handles
+from ..io.input_files import read_input_bytes
+from ..io.mesh import WRITE_FORMATS, format_mesh, read_mesh
+from ..runtime.commit import commit_files
+from ..runtime.errors import InputError, excerpt
+from ..solver.settings import complete, parse_mapping, resolve
+from .compare import compare_meshes
+from .pipeline import deform_mesh
+
+JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
+SUMMARY_FIELDS = ("job", "status", "iterations", "energy", "seconds", "compare_max", "message")
+
+
+def load_manifest(path):
+    """Jobs of a manifest, with absolute paths and merged settings (list of dict)."""
+    doc = load_document(path, "json" if path.lower().endswith(".json") else "yaml")
+    if not isinstance(doc, dict) or not isinstance(doc.get("jobs"), list) or not doc["jobs"]:
+        raise InputError(f"{path}: a manifest needs a non-empty 'jobs' list")
+    base = os.path.dirname(os.path.abspath(path))
+    defaults = _settings(path, "defaults", doc.get("defaults", {}))
+    jobs, names, outputs = [], set(), set()
+    for k, job in enumerate(doc["jobs"]):
+        where = f"{path}: job {k}"
+        if not isinstance(job, dict) or not {"mesh", "handles", "output"} <= set(job):
+            raise InputError(f"{where}: needs mesh, handles and output")
+        unknown = sorted(set(job) - set(JOB_KEYS))
+        if unknown:
+            raise InputError(f"{where}: unknown key {unknown[0]!r}")
+        output = _output_name(where, job["output"])
+        if output in outputs:
+            raise InputError(f"{where}: output {output!r} is also another job's output")
+        outputs.add(output)
+        name = str(job.get("name", os.path.splitext(output)[0]))
+        if name in names:
+            raise InputError(f"{where}: job name {name!r} used twice")
+        names.add(name)
+        expect = job.get("expect")
+        if expect is not None:
+            if not isinstance(expect, dict) or "golden" not in expect:
+                raise InputError(f"{where}: expect needs a golden mesh")
+            tol = expect.get("tol", 0.0)
+            if isinstance(tol, bool) or not isinstance(tol, (int, float)) \
+                    or not math.isfinite(tol) or tol < 0:
+                raise InputError(f"{where}: expect: tol must be a finite number >= 0")
+            expect = {"golden": os.path.join(base, str(expect["golden"])),
+                      "tol": float(tol),
+                      "relative": bool(expect.get("relative", False))}
+        jobs.append({"name": name, "mesh": os.path.join(base, str(job["mesh"])),
+                     "handles": os.path.join(base, str(job["handles"])),
+                     "output": output, "expect": expect,
+                     "settings": {**defaults, **_settings(where, "settings",
+                                                          job.get("settings", {}))}})
+    return jobs
+
+
+def _output_name(where, value):
+    """A job's output as a relative path inside the output folder, with a mesh extension."""
+    if not isinstance(value, str) or not value:
+        raise InputError(f"{where}: output must be a file name")
+    norm = os.path.normpath(value)
+    if os.path.isabs(value) or norm == ".." or norm.startswith(".." + os.sep):
+        raise InputError(f"{where}: output {excerpt(value)!r} must stay inside the output "
+                         "folder (-o): no absolute path, no '..'")
+    if os.path.splitext(norm)[1].lower() not in WRITE_FORMATS:
+        raise InputError(f"{where}: output {excerpt(value)!r} needs one of the extensions "
+                         f"{', '.join(WRITE_FORMATS)}")
+    return norm
+
+
+def check_outputs(jobs, out_dir, manifest):
+    """Refuse a run whose outputs (or their sidecars) would land on any job's input or the
+    manifest: a batch must never overwrite what it reads."""
+    inputs = {os.path.realpath(manifest)}
+    for job in jobs:
+        for path in (job["mesh"], job["handles"], *referenced_files(job["handles"]),
+                     *([job["expect"]["golden"]] if job["expect"] else [])):
+            inputs.add(os.path.realpath(path))
+    for job in jobs:
+        out = os.path.realpath(os.path.join(out_dir, job["output"]))
+        for path in (out, out + ".srarap.json"):
+            if path in inputs:
+                raise InputError(f"{manifest}: job {job['name']!r}: output {job['output']!r} "
+                                 "would overwrite one of the batch's inputs")
+
+
+def _settings(where, key, spec):
+    return parse_mapping(spec, key, lambda message: InputError(f"{where}: {message}"))
+
+
+def referenced_files(handles):
+    """Files a handle file names (``.dmat``, ``.sel``, ``.def``, ...): every string in it that
+    is the path of an existing file, relative to the handle file; a ``.sel`` brings its ``.def``."""
+    base = os.path.dirname(os.path.abspath(handles))
+    if handles.lower().endswith(".sel"):
+        return [os.path.splitext(handles)[0] + ".def"]
+    try:
+        doc = load_document(handles, "yaml")  # JSON is YAML too
+    except InputError:
+        return []
+    found, stack = [], [doc]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, dict):
+            stack.extend(item.values())
+        elif isinstance(item, list):
+            stack.extend(item)
+        elif isinstance(item, str) and os.path.isfile(os.path.join(base, item)):
+            found.append(os.path.join(base, item))
+    return sorted(set(found))
+
+
+def fingerprint(job):
+    """Content hash of everything that decides a job's output."""
+    h = hashlib.sha256()
+    for path in (job["mesh"], job["handles"], *referenced_files(job["handles"])):
+        try:
+            h.update(hashlib.sha256(read_input_bytes(path)).digest())
+        except InputError:
+            h.update(b"missing:" + path.encode())
+    h.update(json.dumps([job["settings"], job["output"], metadata.version("srarap-cli")],
+                        sort_keys=True).encode())
+    return h.hexdigest()
+
+
+def run_job(job, out_dir):
+    """Run one job; never raises. Returns its summary row (dict with SUMMARY_FIELDS)."""
+    start = time.perf_counter()
+    row = {"job": job["name"], "status": "failed", "iterations": None, "energy": None,
+           "seconds": None, "compare_max": None, "message": ""}
+    out = os.path.join(out_dir, job["output"])
+    sidecar = out + ".srarap.json"
+    try:
+        key = fingerprint(job)
+        if os.path.exists(out) and _recorded(sidecar) == key:
+            recorded = _recorded_row(sidecar)
+            # an unchanged job that did not converge stays not converged, run after run
+            row.update(recorded, status="up-to-date" if recorded["status"] == "ok" else
+                       recorded["status"])
+            if row["status"] != "up-to-date":
+                row["message"] = "inputs unchanged since the recorded run"
+        else:
+            mesh = read_mesh(job["mesh"])
+            constraints = load_handles(job["handles"], mesh.vertices)
+            opts = resolve(constraints.solver, job["settings"])
+            deformed, result, _ = deform_mesh(mesh, constraints, name=job["mesh"],
+                                              settings=opts)
+            data, _ = format_mesh(deformed, os.path.splitext(out)[1].lower())
+            status = "ok" if complete(result, opts) else "not-converged"
+            row.update(status=status, iterations=result.iterations, energy=result.energy)
+            os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+            commit_files([(out, data), (sidecar, json.dumps(
+                {"fingerprint": key, "iterations": result.iterations,
+                 "energy": result.energy, "status": status}).encode())])
+        if job["expect"] is not None:
+            _check_golden(row, job["expect"], out)
+    except Exception as exc:  # noqa: BLE001 -- a failing job is reported, never fatal
+        row.update(status="failed", message=str(exc).splitlines()[0] if str(exc) else
+                   type(exc).__name__)
+    row["seconds"] = time.perf_counter() - start
+    return row
+
+
+def _check_golden(row, expect, out):
+    figures = compare_meshes(read_mesh(expect["golden"]), read_mesh(out))
+    scale = figures["diagonal"] if expect["relative"] and figures["diagonal"] > 0 else 1.0
+    row["compare_max"] = figures["max"] / scale
+    if row["compare_max"] > expect["tol"]:
+        row["status"] = "regressed"
+        row["message"] = f"max distance {row['compare_max']:.3g} > tol {expect['tol']:g}"
+
+
+def _recorded(sidecar):
+    try:
+        with open(sidecar) as fh:
+            rec = json.load(fh)
+        # a record without a status predates status records: run the job again
+        return rec.get("fingerprint") if "status" in rec else None
+    except (OSError, ValueError):
+        return None
+
+
+def _recorded_row(sidecar):
+    with open(sidecar) as fh:
+        rec = json.load(fh)
+    return {"iterations": rec.get("iterations"), "energy": rec.get("energy"),
+            "status": rec["status"]}
+
+
+def run_batch(jobs, out_dir, workers=1, scheduler=None):
+    """Run jobs: on a Dask cluster at ``scheduler``, else in ``workers`` local processes
+    (in this process when 1). Rows come back in manifest order.
+
+    The Dask workers must see the same files as this process (a shared file system).
+    """
+    if scheduler is not None:
+        return _run_on_dask(jobs, out_dir, scheduler)
+    if workers <= 1:
+        return [run_job(job, out_dir) for job in jobs]
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(run_job, jobs, [out_dir] * len(jobs)))
+
+
+def _run_on_dask(jobs, out_dir, scheduler):
+    try:
+        from distributed import Client
+    except ImportError:
+        raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
+    out_dir = os.path.abspath(out_dir)
+    try:
+        client = Client(scheduler, timeout=30)
+    except (OSError, TimeoutError) as exc:
+        raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+    with client:
+        futures = client.map(run_job, jobs, [out_dir] * len(jobs), pure=False)
+        return client.gather(futures)

@@ -1,0 +1,134 @@
+"""From a mesh and its constraints to the deformed mesh: the path every command shares."""
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..io.handles import Constraints
+from ..io.mesh import Mesh
+from ..runtime.errors import InputError
+from ..solver.deformer import DeformResult
+from ..solver.mesh_checks import geometry_problem, mesh_warnings, solvable_faces
+from ..solver.oneshot import make_deformer
+from ..solver.operators import mesh_area
+from ..solver.quaternion import IDENTITY
+from ..solver.region import restrict
+from ..solver.settings import Settings, resolve
+
+
+@dataclass
+class Problem:
+    """The triangle mesh a solve works on (all of it, or the region of interest's part).
+
+    Attributes
+    ----------
+    vertices : (s,) int array, ids in the full mesh
+    V : (s, 3) float array; F : (f, 3) int array, in solve ids
+    ids : (k,) int array, constrained solve ids; targets : (k, 3) float array
+    labels : (k,) int array, handle group of each constrained vertex (the file's first group
+        holding it; vertices a region holds at rest form one more group)
+    area : float or None, the whole mesh's area when the solve covers only a region
+    """
+
+    vertices: np.ndarray
+    V: np.ndarray
+    F: np.ndarray
+    ids: np.ndarray
+    targets: np.ndarray
+    labels: np.ndarray
+    area: float = None
+    sub: object = None
+
+    def targets_for(self, constraint_targets):
+        """Solve targets for a new set of constraint targets (same constrained vertices)."""
+        if self.sub is None:
+            return constraint_targets
+        out = self.targets.copy()
+        out[self.sub.slots] = constraint_targets[self.sub.which]
+        return out
+
+
+def problem(mesh, constraints, name="mesh"):
+    """Triangulate ``mesh`` (faces that repeat a vertex left out) and cut it down to the
+    region of interest, if there is one. ``name`` (the mesh's file) starts error messages.
+
+    Raises
+    ------
+    InputError : no solvable geometry, or a region of interest with nothing free to move
+    """
+    V = mesh.vertices
+    F = solvable_faces(mesh.triangles()[0])
+    why = geometry_problem(V, F)
+    if why is not None:
+        raise InputError(f"{name}: {why}")
+    if constraints.region is None:
+        return Problem(np.arange(len(V)), V, F, constraints.ids, constraints.targets,
+                       _labels(constraints, constraints.ids))
+    sub = restrict(V, F, constraints.ids, constraints.targets, constraints.region)
+    if not len(sub.faces):
+        raise InputError(f"{name}: the region of interest holds no vertex free to move "
+                         "(every vertex in it is constrained)")
+    return Problem(sub.vertices, V[sub.vertices], sub.faces, sub.constrained, sub.targets,
+                   _labels(constraints, sub.vertices[sub.constrained]), mesh_area(V, F), sub)
+
+
+def _labels(constraints, full_ids):
+    labels = np.full(len(full_ids), len(constraints.groups), dtype=np.int64)
+    for g, members in reversed(list(enumerate(constraints.groups.values()))):
+        labels[np.isin(full_ids, members)] = g
+    return np.unique(labels, return_inverse=True)[1].ravel()
+
+
+def build_deformer(p, opts, cache=None):
+    """The solver of a :class:`Problem` with resolved settings ``opts`` (see
+    :func:`~srarap_cli.solver.oneshot.make_deformer`; ``cache``: folder for coarse meshes)."""
+    return make_deformer(p.V, p.F, p.ids, p.labels, area=p.area, cache=cache,
+                         **opts.stage("setup", "build"))
+
+
+def scatter(mesh, p, positions, constraints, constraint_targets=None):
+    """Full-mesh positions from a problem's solved positions. Constrained vertices go to their
+    targets even where a region of interest left them out of the solve (handle vertices
+    whose triangles touch no movable vertex)."""
+    out = mesh.vertices.copy()
+    out[p.vertices] = positions
+    out[constraints.ids] = constraints.targets if constraint_targets is None else constraint_targets
+    return out
+
+
+def deform_mesh(mesh: Mesh, constraints: Constraints,
+                callback: Callable[[dict], None] | None = None, cache: str | None = None,
+                name: str = "mesh", settings: Settings | None = None,
+                **overrides: Any) -> tuple[Mesh, DeformResult, list[str]]:
+    """Deform a :class:`~srarap_cli.io.mesh.Mesh` by its :class:`~srarap_cli.io.handles.Constraints`.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    constraints : Constraints
+    callback : callable(dict), optional, receives each log row
+    cache : str, optional, folder for multiresolution coarse meshes
+    name : str, the mesh's file, for error messages
+    settings : Settings, optional, already resolved (the command line's); then no overrides
+    **overrides : any solver setting (see :mod:`srarap_cli.solver.settings`); None means the
+        handle file's value or the default
+
+    Returns
+    -------
+    deformed : Mesh, same vertices and faces, new positions and normals
+    result : DeformResult (or MultiresResult), positions/rotors of the whole mesh
+    warnings : list of str
+    """
+    if settings is not None and overrides:
+        raise TypeError("deform_mesh() takes settings or keyword overrides, not both")
+    opts = settings if settings is not None else resolve(constraints.solver, overrides)
+    p = problem(mesh, constraints, name)
+    deformer = build_deformer(p, opts, cache)
+    sub_result = deformer.solve(p.targets, callback=callback, **opts.stage("solve"))
+    positions = scatter(mesh, p, sub_result.positions, constraints)
+    rotors = np.tile(IDENTITY, (len(positions), 1))
+    rotors[p.vertices] = sub_result.rotors
+    result = replace(sub_result, positions=positions, rotors=rotors)
+    notes = mesh_warnings(mesh.vertices, mesh.triangles()[0]) + list(deformer.warnings)
+    return mesh.with_vertices(positions), result, notes
