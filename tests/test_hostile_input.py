@@ -218,7 +218,7 @@ def test_bad_input_is_one_line_with_the_documented_code(tmp_path, args, files, c
     ("../../x.obj", "must stay inside the output folder"),
     ("/tmp/elsewhere.obj", "must stay inside the output folder"),
     ("../jobs.yaml", "must stay inside the output folder"),
-    ("m.obj", "would overwrite one of the batch's inputs"),
+    ("m.obj", "refusing to overwrite an input"),
     ("h.yaml.srarap.json.obj", None),
     ("o.txt", "needs one of the extensions"),
     ("o", "needs one of the extensions"),

@@ -52,18 +52,22 @@ def test_keep_unconverged_writes_the_mesh_and_still_exits_3(folder):
     assert "no mesh written" in p.stderr and "raise --max-iter" in p.stderr
 
 
-def batch(folder, settings):
+def batch(folder, settings, *extra):
     (folder / "jobs.yaml").write_text(
         f"jobs:\n  - {{mesh: m.obj, handles: h.yaml, output: a.obj, settings: {settings}}}\n")
-    p = subprocess.run([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o", "out"],
-                       cwd=folder, capture_output=True, text=True, timeout=300)
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o", "out",
+                        *extra], cwd=folder, capture_output=True, text=True, timeout=300)
     rows = json.loads((folder / "out" / "summary.json").read_text())
     return p.returncode, rows[0]["status"]
 
 
 def test_batch_remembers_a_job_that_did_not_converge(folder):
     assert batch(folder, "{max_iter: 2}") == (3, "not-converged")
+    assert not (folder / "out" / "a.obj").exists()  # exit 3 writes no mesh, as deform
     assert batch(folder, "{max_iter: 2}") == (3, "not-converged")  # nothing changed
+    assert not (folder / "out" / "a.obj").exists()
+    assert batch(folder, "{max_iter: 2}", "--keep-unconverged") == (3, "not-converged")
+    assert (folder / "out" / "a.obj").exists()
     assert batch(folder, "{max_iter: 1000}") == (0, "ok")  # settings changed: run again
     assert batch(folder, "{max_iter: 1000}") == (0, "up-to-date")
 

@@ -8,7 +8,7 @@ import time
 
 import click
 
-from ..io.handles import load_handles
+from ..io.handles import load_handles, referenced_files
 from ..io.mesh import WRITE_FORMATS, format_mesh, read_mesh
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime.commit import commit_files
@@ -16,10 +16,11 @@ from ..runtime.errors import InputError, OutputError
 from ..runtime.limits import check_solve
 from ..solver.settings import resolve
 from ..tasks.animation import FRAME_FIELDS, Animator, FrameState, fingerprint
-from .common import cache_option, check_output_path, guarded
+from .common import cache_option, check_output_path, finite_option, guarded, refuse_overwrite
 from .options import settings_options
 
 STATE_NAME = ".srarap-animate-state.npz"
+MAX_FRAMES = 100_000
 
 
 @click.command("animate")
@@ -29,8 +30,11 @@ STATE_NAME = ".srarap-animate-state.npz"
               help="Frame file pattern with a format field, e.g. 'out/frame_{:04d}.obj'.")
 @click.option("--frames", type=click.IntRange(min=1),
               help="Number of frames. [default: up to the last keyframe]")
-@click.option("--fps", type=click.FloatRange(min=0, min_open=True),
+@click.option("--fps", type=click.FloatRange(min=0, min_open=True), callback=finite_option,
               help="Frames per second, for keyframes given by time.")
+@click.option("--max-frames", type=click.IntRange(min=1), default=MAX_FRAMES, show_default=True,
+              help="Refuse an animation of more frames than this (a typo in --fps or a "
+                   "keyframe time would otherwise fill the disk); raise it on purpose.")
 @click.option("--iters-per-frame", type=click.IntRange(min=1), default=20, show_default=True,
               help="Local/global iterations per frame at most.")
 @click.option("--log", "log", help="Per-frame log: .csv or .jsonl.")
@@ -39,8 +43,8 @@ STATE_NAME = ".srarap-animate-state.npz"
 @cache_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress, summary or warnings.")
 @guarded
-def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, overrides, cache,
-            quiet):
+def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, log, resume,
+            overrides, cache, quiet):
     """Deform MESH through the keyframes of HANDLES, writing one mesh per frame.
 
     Each frame starts from the previous one (positions and rotors) and iterates until --tol or
@@ -54,10 +58,13 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, o
     source = read_mesh(mesh)
     check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices, fps=fps)
-    n_frames = frames or math.floor(constraints.last_key_frame) + 1
-    opts = resolve(constraints.solver, overrides)
-    run_id = fingerprint((mesh, handles), opts, n_frames, fps, iters_per_frame, pattern)
+    n_frames = _frame_count(frames, constraints.last_key_frame, max_frames, handles)
     state_path = os.path.join(folder, STATE_NAME)
+    refuse_overwrite([pattern.format(f) for f in range(n_frames)] + [log], mesh=mesh,
+                     handles=handles, others=[("resume state", state_path)])
+    opts = resolve(constraints.solver, overrides)
+    run_id = fingerprint((mesh, handles, *referenced_files(handles)), opts, n_frames, fps,
+                         iters_per_frame, pattern)
     state = _resume_state(state_path, run_id) if resume else None
     animator = Animator(source, constraints, opts, cache=cache, name=mesh)
     progress = _Progress(n_frames, enabled=not quiet and sys.stderr.isatty())
@@ -88,6 +95,17 @@ def animate(mesh, handles, pattern, frames, fps, iters_per_frame, log, resume, o
         click.echo(f"srarap animate: {len(rows)} frames ({stalled} stopped at "
                    f"--iters-per-frame {iters_per_frame}); {len(rows) / max(seconds, 1e-9):.2f} "
                    f"frames/s; {wrote}", err=True)
+
+
+def _frame_count(frames, last_key_frame, max_frames, handles):
+    n = frames if frames is not None else (
+        math.floor(last_key_frame) + 1 if math.isfinite(last_key_frame) else math.inf)
+    if n > max_frames:
+        why = "--frames" if frames is not None else f"the last keyframe of {handles} (with --fps)"
+        shown = f"{n:.3g}" if isinstance(n, float) else str(n)
+        raise InputError(f"{why} makes {shown} frames, more than --max-frames {max_frames}; "
+                         "raise --max-frames to render them")
+    return int(n)
 
 
 def _fields(pattern):

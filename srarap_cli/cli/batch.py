@@ -21,14 +21,17 @@ from .common import guarded
               "(pip install 'srarap-cli[dask]'); its workers must share this file system.")
 @click.option("-o", "--output", "out", default=".", show_default=True,
               help="Folder for the jobs' outputs and summary.csv / summary.json.")
+@click.option("--keep-unconverged", is_flag=True,
+              help="Write the mesh of a job that did not converge (exit code still 3).")
 @click.option("-q", "--quiet", is_flag=True, help="No summary table.")
 @guarded
-def batch(manifest, workers, scheduler, out, quiet):
+def batch(manifest, workers, scheduler, out, keep_unconverged, quiet):
     """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
 
     Exit code 0 when every job is ok or up to date, 8 when any job failed or regressed
-    against its golden mesh, else 3 when any did not converge (recorded: an unchanged job
-    reports it again on every rerun).
+    against its golden mesh, else 3 when any did not converge (its mesh is not written unless
+    --keep-unconverged; the status is recorded, so an unchanged job reports it again on every
+    rerun without solving).
     """
     jobs = load_manifest(manifest)
     check_outputs(jobs, out, manifest)
@@ -36,7 +39,7 @@ def batch(manifest, workers, scheduler, out, quiet):
         os.makedirs(out, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
-    rows = run_batch(jobs, out, workers, scheduler)
+    rows = run_batch(jobs, out, workers, scheduler, keep_unconverged)
     commit_files([(os.path.join(out, "summary.csv"), _csv(rows).encode()),
                   (os.path.join(out, "summary.json"), (json.dumps(rows, indent=2) + "\n").encode())])
     counts = {s: sum(r["status"] == s for r in rows) for s in

@@ -12,13 +12,14 @@ from ..solver.settings import resolve
 from ..tasks.bench import ALL_METHODS, IGL, run_methods
 from ..tasks.bench_report import curves_csv, plot_png, summary_json, table
 from ..tasks.pipeline import problem
-from .common import guarded
+from .common import guarded, refuse_overwrite
 from .options import settings_options
 
 CHOICES = ALL_METHODS + (IGL,)
 # bench measures how fast each method approaches the minimum, so it runs far past the usual
 # stopping point unless told otherwise (the handle file's tol and max_iter do not apply)
 OWN_DEFAULTS = {"tol": 1e-9, "max_iter": 100000}
+BENCH_FILES = ("curves.csv", "summary.json", "energy.png")
 
 
 @click.command("bench")
@@ -28,7 +29,7 @@ OWN_DEFAULTS = {"tol": 1e-9, "max_iter": 100000}
               help=f"Comma-separated, from: {', '.join(CHOICES)}.")
 @click.option("--time-budget", type=click.FloatRange(min=0, min_open=True), default=30.0,
               show_default=True, help="Seconds each method may run.")
-@click.option("-o", "--output", "out", type=click.Path(file_okay=False),
+@click.option("-o", "--output", "out",
               help="Folder for curves.csv, summary.json and energy.png (created if missing).")
 @settings_options(exclude=("method", "multires", "multires_mode", "time_limit", "accel", "start"),
                defaults=OWN_DEFAULTS)
@@ -46,6 +47,8 @@ def bench(mesh, handles, methods, time_budget, out, overrides):
         raise click.BadParameter(f"unknown method {unknown[0] if unknown else '(none)'!r}; "
                                  f"choose from {', '.join(CHOICES)}", param_hint="--methods")
     if out is not None:
+        refuse_overwrite([os.path.join(out, name) for name in BENCH_FILES], mesh=mesh,
+                         handles=handles)
         _prepare_folder(out)
     source = read_mesh(mesh)
     check_solve(mesh, len(source.vertices))
@@ -62,9 +65,10 @@ def bench(mesh, handles, methods, time_budget, out, overrides):
                 "constrained": len(p.ids), "time_budget": time_budget,
                 **{k: getattr(opts, k) for k in ("alpha", "feedback", "weights", "sweeps")}}
         title = f"{os.path.basename(mesh)} ({len(p.V)} vertices)"
-        commit_files([(os.path.join(out, "curves.csv"), curves_csv(runs).encode()),
-                      (os.path.join(out, "summary.json"), summary_json(runs, info).encode()),
-                      (os.path.join(out, "energy.png"), plot_png(runs, title))])
+        payloads = (curves_csv(runs).encode(), summary_json(runs, info).encode(),
+                    plot_png(runs, title))
+        commit_files([(os.path.join(out, name), data)
+                      for name, data in zip(BENCH_FILES, payloads)])
 
 
 def _prepare_folder(out):

@@ -1,5 +1,6 @@
 """What every subcommand shares: error-to-exit-code mapping and output preflight."""
 import functools
+import math
 import os
 import sys
 import traceback
@@ -7,9 +8,11 @@ import traceback
 import click
 import numpy as np
 
+from ..io.handles import referenced_files
 from ..runtime import exit_codes, signals
 from ..runtime.commit import COMMITTED
 from ..runtime.errors import InputError, NumericalError, OutputError, SingularSystemError
+from ..runtime.paths import refuse_overwriting_inputs
 from ..runtime.signals import Terminated
 
 
@@ -88,6 +91,24 @@ def check_output_path(path, allowed, what):
         raise OutputError(f"{path}: folder {folder} is not writable")
     if os.path.isdir(path):
         raise OutputError(f"{path}: is a folder")
+
+
+def finite_option(_ctx, _param, value):
+    """Click callback: a float option must be finite (FloatRange lets inf through)."""
+    if value is not None and not math.isfinite(value):
+        raise click.BadParameter("must be a finite number")
+    return value
+
+
+def refuse_overwrite(outputs, *, mesh=None, handles=None, others=()):
+    """Fail (exit 4) before any work when an output is one of the run's inputs: the mesh, the
+    handle file, the files it names, or ``others`` ((what, path) pairs)."""
+    inputs = [("mesh", mesh)] if mesh not in (None, "-") else []
+    if handles is not None:
+        inputs.append(("handle file", handles))
+        inputs += [("file the handle file names", p) for p in referenced_files(handles)]
+    refuse_overwriting_inputs([o for o in outputs if o not in (None, "-")],
+                              inputs + list(others))
 
 
 cache_option = click.option("--cache", type=click.Path(file_okay=False),

@@ -7,7 +7,7 @@ from ..io.mesh import read_mesh
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..tasks.compare import compare_meshes
-from .common import check_output_path, guarded
+from .common import check_output_path, guarded, refuse_overwrite
 
 
 @click.command("compare")
@@ -28,6 +28,7 @@ def compare(a, b, tol, relative, report, quiet):
     """
     if report is not None:
         check_output_path(report, (".json",), "--json")
+    refuse_overwrite([report], others=[("mesh A", a), ("mesh B", b)])
     ma, mb = read_mesh(a), read_mesh(b)
     figures = compare_meshes(ma, mb)
     scale = figures["diagonal"] if relative and figures["diagonal"] > 0 else 1.0

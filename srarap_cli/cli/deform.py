@@ -19,7 +19,7 @@ from ..solver.settings import complete, resolve
 from ..tasks.distortion import vertex_distortion
 from ..tasks.pipeline import deform_mesh
 from ..tasks.preview import preview_png
-from .common import cache_option, check_output_path, guarded
+from .common import cache_option, check_output_path, guarded, refuse_overwrite
 from .options import settings_options
 from .progress import SolveProgress
 
@@ -66,6 +66,7 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
         check_output_path(log, LOG_FORMATS, "log")
         if os.path.abspath(log) == os.path.abspath(out):
             raise click.UsageError("--log and --output name the same file")
+    refuse_overwrite([out, log, preview], mesh=mesh, handles=handles)
     source = read_stdin_mesh(input_format) if mesh == "-" else read_mesh(mesh)
     name = "<stdin>" if mesh == "-" else mesh
     check_solve(name, len(source.vertices))

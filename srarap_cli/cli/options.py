@@ -4,12 +4,12 @@ The solver's settings module knows nothing of Click; this is the only place the 
 command-line flags.
 """
 import functools
-import math
 
 import click
 
 from ..solver.multires.size import parse_size
 from ..solver.settings import SETTINGS, Setting
+from .common import finite_option
 
 
 def setting_option(setting: Setting, default=None):
@@ -26,15 +26,9 @@ def setting_option(setting: Setting, default=None):
         kind, callback = click.IntRange(min=setting.minimum, min_open=setting.strict), None
     else:
         kind = click.FloatRange(min=setting.minimum, min_open=setting.strict)
-        callback = _finite_option
+        callback = finite_option
     return click.option(setting.flag, setting.name, type=kind, metavar=setting.metavar,
                         help=text, callback=callback)
-
-
-def _finite_option(_ctx, _param, value):
-    if value is not None and not math.isfinite(value):
-        raise click.BadParameter("must be a finite number")
-    return value
 
 
 def _size_option(_ctx, _param, value):

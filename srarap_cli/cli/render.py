@@ -11,7 +11,7 @@ from ..io.mesh import read_mesh
 from ..runtime.commit import commit_files
 from ..tasks.preview import preview_png
 from ..tasks.render import VIEWS
-from .common import check_output_path, guarded
+from .common import check_output_path, guarded, refuse_overwrite
 
 
 def parse_size(text):
@@ -50,6 +50,8 @@ def render(mesh, out, handles, rest, color, layout, up, views, size):
     size = parse_size(size)
     for view in views:
         _check_view(view)
+    refuse_overwrite([out], mesh=mesh, handles=handles,
+                     others=[("rest mesh", rest)] if rest else [])
     shown = read_mesh(mesh)
     base = read_mesh(rest) if rest else None
     if base is not None and len(base.vertices) != len(shown.vertices):
@@ -81,6 +83,7 @@ def _check_view(view):
 def plot(logs, out, size):
     """Plot total energy against iteration and time for one or more deform logs (CSV/JSONL)."""
     check_output_path(out, (".png",), "output")
+    refuse_overwrite([out], others=[("log", path) for path in logs])
     w, h = parse_size(size)
     import io
 

@@ -4,15 +4,22 @@ A FIFO, ``/dev/zero``, ``/dev/urandom`` or a socket given as a mesh or handle fi
 forever or read without bound; the size checks that guard memory mean nothing for them. The
 file is opened without blocking and checked on the open descriptor, so nothing can swap it
 between the check and the read.
+
+A UTF-8 byte order mark at the start of any input is skipped, so a file saved by an editor
+that writes one reads exactly like the same file without it.
 """
 import os
 import stat
 
 from ..runtime.errors import InputError
 
+BOM = b"\xef\xbb\xbf"
+
 
 def open_input(path, mode="r", **kwargs):
-    """``open(path, mode, **kwargs)`` for reading, refusing anything but a regular file.
+    """``open(path, mode, **kwargs)`` for reading, refusing anything but a regular file; in
+    binary mode the stream starts after a leading UTF-8 byte order mark, in text mode
+    ``utf-8`` is read as ``utf-8-sig`` (the same).
 
     Raises
     ------
@@ -41,6 +48,13 @@ def open_input(path, mode="r", **kwargs):
             raise InputError(f"{path}: not a regular file (a device, FIFO or socket); give a file")
         if hasattr(os, "set_blocking"):
             os.set_blocking(fd, True)
+        if "b" in mode:
+            fh = os.fdopen(fd, mode, **kwargs)
+            if fh.read(len(BOM)) != BOM:
+                fh.seek(0)
+            return fh
+        if kwargs.get("encoding", "utf-8").lower().replace("_", "-") in ("utf-8", "utf8"):
+            kwargs["encoding"] = "utf-8-sig"
         return os.fdopen(fd, mode, **kwargs)
     except BaseException:
         os.close(fd)
@@ -48,6 +62,7 @@ def open_input(path, mode="r", **kwargs):
 
 
 def read_input_bytes(path):
-    """The whole content of a regular file (see :func:`open_input`)."""
+    """The whole content of a regular file, less a leading byte order mark (see
+    :func:`open_input`)."""
     with open_input(path, "rb") as fh:
         return fh.read()

@@ -1,6 +1,8 @@
 """Write several output files all-or-nothing: all to temporary names, then all renamed."""
 import glob
 import os
+import secrets
+import shutil
 import signal
 import tempfile
 
@@ -13,30 +15,93 @@ _SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
 def commit_files(files):
-    """Write ``[(path, bytes), ...]``; on any failure no target is created or replaced.
+    """Write ``[(path, bytes), ...]`` as one unit: on any failure every target is left exactly
+    as it was (not created, or its old content).
 
     Every payload goes to a temporary file in its target's folder first; only when all are
-    written are they renamed over the targets (a rename within a folder is atomic).
+    written are they renamed over the targets (a rename within a folder is atomic). A target
+    that existed is kept under a temporary name (a hard link) until every rename succeeded, so
+    a rename that fails late (the target became a folder, the disk went read-only) puts back
+    what the earlier ones replaced.
     """
     staged = []
     try:
         for path, data in files:
-            staged.append((_stage(path, data), path))
+            staged.append((_named(path, _stage, path, data), path))
         # the renames and their record are one critical section: a SIGINT/SIGTERM waits
         # until both are done, so the report always matches the files on disk
         blocked = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
         try:
-            for tmp, path in staged:
-                os.replace(tmp, path)
-                COMMITTED.append(path)
+            _replace_all(staged)
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
-    except OSError as exc:
-        raise OutputError(f"{exc.filename or files[0][0]}: cannot write: {exc.strerror}") from None
     finally:
         for tmp, _ in staged:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+            _remove(tmp)
+
+
+def _replace_all(staged):
+    done = []  # (path, kept copy of its old content or None), each already replaced
+    try:
+        for tmp, path in staged:
+            kept = _named(path, _keep, path)
+            try:
+                _named(path, os.replace, tmp, path)
+            except BaseException:
+                _remove(kept)
+                raise
+            done.append((path, kept))
+    except BaseException:
+        for path, kept in reversed(done):
+            _restore(path, kept)
+        raise
+    COMMITTED.extend(path for _, path in staged)
+    for _, kept in done:
+        _remove(kept)
+
+
+def _restore(path, kept):
+    try:
+        if kept is None:
+            os.unlink(path)
+        else:
+            os.replace(kept, path)
+    except OSError:  # nothing more can be done; the failure being reported stays the cause
+        pass
+
+
+def _named(path, func, *args):
+    """``func(*args)``, with an OSError reported against the user's ``path`` (not a
+    temporary name)."""
+    try:
+        return func(*args)
+    except OSError as exc:
+        reason = "is a folder" if isinstance(exc, IsADirectoryError) or os.path.isdir(path) \
+            else f"cannot write: {exc.strerror or exc}"
+        raise OutputError(f"{path}: {reason}") from None
+
+
+def _keep(path):
+    """A temporary hard link to the existing regular file ``path`` (None if there is none)."""
+    if os.path.isdir(path):
+        raise IsADirectoryError(path)
+    if not os.path.isfile(path):
+        return None
+    kept = os.path.join(os.path.dirname(os.path.abspath(path)),
+                        f".srarap-{os.getpid()}-{secrets.token_hex(6)}.tmp")
+    try:
+        os.link(path, kept)
+    except OSError:  # a file system without hard links: a copy does the same job
+        shutil.copy2(path, kept)
+    return kept
+
+
+def _remove(tmp):
+    if tmp is not None and os.path.lexists(tmp):
+        try:
+            os.unlink(tmp)
+        except OSError:  # swept already, or the folder went away: nothing left to clean
+            pass
 
 
 def atomic_write(path, data):

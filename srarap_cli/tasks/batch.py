@@ -15,6 +15,7 @@ A job is up to date when its output exists and the sidecar ``<output>.srarap.jso
 the same fingerprint (content of the mesh, the handle file and every file it names, settings,
 srarap version).
 """
+import functools
 import hashlib
 import json
 import math
@@ -24,11 +25,12 @@ from concurrent.futures import ProcessPoolExecutor
 from importlib import metadata
 
 from ..io.documents import load_document
-from ..io.handles import load_handles
+from ..io.handles import load_handles, referenced_files
 from ..io.input_files import read_input_bytes
 from ..io.mesh import WRITE_FORMATS, format_mesh, read_mesh
 from ..runtime.commit import commit_files
 from ..runtime.errors import InputError, excerpt
+from ..runtime.paths import refuse_overwriting_inputs
 from ..solver.settings import complete, parse_mapping, resolve
 from .compare import compare_meshes
 from .pipeline import deform_mesh
@@ -96,43 +98,22 @@ def _output_name(where, value):
 def check_outputs(jobs, out_dir, manifest):
     """Refuse a run whose outputs (or their sidecars) would land on any job's input or the
     manifest: a batch must never overwrite what it reads."""
-    inputs = {os.path.realpath(manifest)}
+    inputs = [("manifest", manifest)]
     for job in jobs:
-        for path in (job["mesh"], job["handles"], *referenced_files(job["handles"]),
-                     *([job["expect"]["golden"]] if job["expect"] else [])):
-            inputs.add(os.path.realpath(path))
-    for job in jobs:
-        out = os.path.realpath(os.path.join(out_dir, job["output"]))
-        for path in (out, out + ".srarap.json"):
-            if path in inputs:
-                raise InputError(f"{manifest}: job {job['name']!r}: output {job['output']!r} "
-                                 "would overwrite one of the batch's inputs")
+        inputs += [(f"mesh of job {job['name']!r}", job["mesh"]),
+                   (f"handle file of job {job['name']!r}", job["handles"]),
+                   *((f"file named by job {job['name']!r}'s handles", path)
+                     for path in referenced_files(job["handles"])),
+                   *([(f"golden mesh of job {job['name']!r}", job["expect"]["golden"])]
+                     if job["expect"] else [])]
+    outputs = [os.path.join(out_dir, name) for job in jobs
+               for name in (job["output"], job["output"] + ".srarap.json")]
+    outputs += [os.path.join(out_dir, name) for name in ("summary.csv", "summary.json")]
+    refuse_overwriting_inputs(outputs, inputs)
 
 
 def _settings(where, key, spec):
     return parse_mapping(spec, key, lambda message: InputError(f"{where}: {message}"))
-
-
-def referenced_files(handles):
-    """Files a handle file names (``.dmat``, ``.sel``, ``.def``, ...): every string in it that
-    is the path of an existing file, relative to the handle file; a ``.sel`` brings its ``.def``."""
-    base = os.path.dirname(os.path.abspath(handles))
-    if handles.lower().endswith(".sel"):
-        return [os.path.splitext(handles)[0] + ".def"]
-    try:
-        doc = load_document(handles, "yaml")  # JSON is YAML too
-    except InputError:
-        return []
-    found, stack = [], [doc]
-    while stack:
-        item = stack.pop()
-        if isinstance(item, dict):
-            stack.extend(item.values())
-        elif isinstance(item, list):
-            stack.extend(item)
-        elif isinstance(item, str) and os.path.isfile(os.path.join(base, item)):
-            found.append(os.path.join(base, item))
-    return sorted(set(found))
 
 
 def fingerprint(job):
@@ -148,8 +129,11 @@ def fingerprint(job):
     return h.hexdigest()
 
 
-def run_job(job, out_dir):
-    """Run one job; never raises. Returns its summary row (dict with SUMMARY_FIELDS)."""
+def run_job(job, out_dir, keep_unconverged=False):
+    """Run one job; never raises. Returns its summary row (dict with SUMMARY_FIELDS).
+
+    A job that does not converge writes its sidecar (the status, so a rerun reports it without
+    solving again) but not its mesh, unless ``keep_unconverged``: as ``srarap deform``."""
     start = time.perf_counter()
     row = {"job": job["name"], "status": "failed", "iterations": None, "energy": None,
            "seconds": None, "compare_max": None, "message": ""}
@@ -157,8 +141,9 @@ def run_job(job, out_dir):
     sidecar = out + ".srarap.json"
     try:
         key = fingerprint(job)
-        if os.path.exists(out) and _recorded(sidecar) == key:
-            recorded = _recorded_row(sidecar)
+        recorded = _recorded_row(sidecar) if _recorded(sidecar) == key else None
+        if recorded is not None and (os.path.exists(out) or (
+                recorded["status"] == "not-converged" and not keep_unconverged)):
             # an unchanged job that did not converge stays not converged, run after run
             row.update(recorded, status="up-to-date" if recorded["status"] == "ok" else
                        recorded["status"])
@@ -174,10 +159,13 @@ def run_job(job, out_dir):
             status = "ok" if complete(result, opts) else "not-converged"
             row.update(status=status, iterations=result.iterations, energy=result.energy)
             os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
-            commit_files([(out, data), (sidecar, json.dumps(
-                {"fingerprint": key, "iterations": result.iterations,
-                 "energy": result.energy, "status": status}).encode())])
-        if job["expect"] is not None:
+            record = json.dumps({"fingerprint": key, "iterations": result.iterations,
+                                 "energy": result.energy, "status": status}).encode()
+            keep = status == "ok" or keep_unconverged
+            commit_files([(out, data)] * keep + [(sidecar, record)])
+            if not keep:
+                row["message"] = "mesh not written (--keep-unconverged writes it)"
+        if job["expect"] is not None and os.path.exists(out) and row["status"] != "not-converged":
             _check_golden(row, job["expect"], out)
     except Exception as exc:  # noqa: BLE001 -- a failing job is reported, never fatal
         row.update(status="failed", message=str(exc).splitlines()[0] if str(exc) else
@@ -212,30 +200,32 @@ def _recorded_row(sidecar):
             "status": rec["status"]}
 
 
-def run_batch(jobs, out_dir, workers=1, scheduler=None):
+def run_batch(jobs, out_dir, workers=1, scheduler=None, keep_unconverged=False):
     """Run jobs: on a Dask cluster at ``scheduler``, else in ``workers`` local processes
-    (in this process when 1). Rows come back in manifest order.
+    (in this process when 1). Rows come back in manifest order. ``keep_unconverged``: see
+    :func:`run_job`.
 
     The Dask workers must see the same files as this process (a shared file system).
     """
+    run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged)
     if scheduler is not None:
-        return _run_on_dask(jobs, out_dir, scheduler)
+        return _run_on_dask(jobs, run, scheduler)
     if workers <= 1:
-        return [run_job(job, out_dir) for job in jobs]
+        return [run(job) for job in jobs]
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(run_job, jobs, [out_dir] * len(jobs)))
+        return list(pool.map(run, jobs))
 
 
-def _run_on_dask(jobs, out_dir, scheduler):
+def _run_on_dask(jobs, run, scheduler):
     try:
         from distributed import Client
     except ImportError:
         raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
-    out_dir = os.path.abspath(out_dir)
+    run = functools.partial(run, out_dir=os.path.abspath(run.keywords["out_dir"]))
     try:
         client = Client(scheduler, timeout=30)
     except (OSError, TimeoutError) as exc:
         raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
     with client:
-        futures = client.map(run_job, jobs, [out_dir] * len(jobs), pure=False)
+        futures = client.map(run, jobs, pure=False)
         return client.gather(futures)

@@ -167,5 +167,31 @@ def _from_sel(path, V):
             raise InputError(f"{def_path}: no such file (the .def that goes with {path})")
         M = read_def(def_path)
         t[handle] = V[handle] @ M[:3, :3].T + M[:3, 3]
+        if not np.isfinite(t[handle]).all():
+            raise InputError(f"{def_path}: sends handle vertices to infinite or NaN positions "
+                             "(entries too large)")
     ids = np.flatnonzero(status != 1)
     return Constraints(ids=ids, targets=t[ids], groups={"fixed": fixed, "handle": handle})
+
+
+def referenced_files(handles):
+    """Files a handle file names (``.dmat``, ``.sel``, ``.def``, ...): every string in it that
+    is the path of an existing file, relative to the handle file; a ``.sel`` brings its ``.def``."""
+    handles = str(handles)
+    base = os.path.dirname(os.path.abspath(handles))
+    if handles.lower().endswith(".sel"):
+        return [os.path.splitext(handles)[0] + ".def"]
+    try:
+        doc = load_document(handles, "yaml")  # JSON is YAML too
+    except InputError:
+        return []
+    found, stack = [], [doc]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, dict):
+            stack.extend(item.values())
+        elif isinstance(item, list):
+            stack.extend(item)
+        elif isinstance(item, str) and os.path.isfile(os.path.join(base, item)):
+            found.append(os.path.join(base, item))
+    return sorted(set(found))

@@ -33,7 +33,11 @@ def read_def(path):
     values = _numbers(path, float)
     if values.size != 16 or not np.isfinite(values).all():
         raise InputError(f"{path}: a .def file holds one 4x4 matrix (16 numbers)")
-    return values.reshape(4, 4)
+    M = values.reshape(4, 4)
+    if not np.allclose(M[3], [0, 0, 0, 1]):
+        raise InputError(f"{path}: row 4 must be 0 0 0 1 (an affine transform), found "
+                         f"{' '.join(f'{x:g}' for x in M[3])}")
+    return M
 
 
 def read_dmat(path):

@@ -43,6 +43,14 @@ def targets(ctx, spec, rest, base):
     translate`` (pivot defaults to the group's centroid), or ``x' = matrix @ [x, 1]`` with a
     4x4 matrix given inline or as the path of a ``.def`` file.
     """
+    out = _moved(ctx, spec, rest, base)
+    if not np.isfinite(out).all():
+        raise ctx.error("the action sends vertices to infinite or NaN positions (entries too "
+                        "large)")
+    return out
+
+
+def _moved(ctx, spec, rest, base):
     keys = [k for k in ACTION_KEYS if k in spec]
     fixed = spec.get("fixed", False)
     if not isinstance(fixed, bool):

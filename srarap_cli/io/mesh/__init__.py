@@ -7,14 +7,16 @@ the target folder, then rename), so a failed run never leaves a partial file beh
 import io
 import os
 import struct
+import tempfile
 import warnings
-from contextlib import redirect_stderr, redirect_stdout
+from contextlib import contextmanager, redirect_stderr, redirect_stdout
 
 import numpy as np
 
 from ...runtime.commit import atomic_write
 from ...runtime.errors import InputError, OutputError
 from ...runtime.limits import check_read
+from ..input_files import open_input
 from .mesh import Mesh
 from .normals import recompute_normals
 from .obj import format_obj, read_obj
@@ -68,18 +70,34 @@ def _read_meshio(path, suffix):
 
     failures = (SystemExit, meshio.ReadError, ValueError, IndexError, KeyError, EOFError,
                 TypeError, struct.error)
-    if not os.path.isfile(path):
-        raise InputError(f"{path}: no such file")
     chatter = io.StringIO()
     try:
         # meshio prints its own message and calls sys.exit() on some files it cannot read
-        with warnings.catch_warnings(), redirect_stdout(chatter), redirect_stderr(chatter):
+        with warnings.catch_warnings(), redirect_stdout(chatter), redirect_stderr(chatter), \
+                _without_bom(path) as plain:
             warnings.simplefilter("ignore")
-            m = meshio.read(path, file_format="stl")
+            m = meshio.read(plain, file_format="stl")
     except failures as exc:
         detail = str(exc) if not isinstance(exc, SystemExit) else "unrecognized content"
         raise InputError(f"{path}: not a readable {suffix[1:].upper()} file ({detail})") from None
     return mesh_from_meshio(m)
+
+
+@contextmanager
+def _without_bom(path):
+    """``path``, or a temporary copy without its leading byte order mark (meshio reads STL
+    only from a path, and would take an ASCII file with a mark for a binary one)."""
+    with open_input(path, "rb") as fh:
+        skipped = fh.tell() > 0
+        data = fh.read() if skipped else None
+    if not skipped:
+        yield path
+        return
+    with tempfile.TemporaryDirectory(prefix="srarap-stl-") as folder:
+        plain = os.path.join(folder, "mesh.stl")
+        with open(plain, "wb") as out:
+            out.write(data)
+        yield plain
 
 
 def _validate(mesh, path):

@@ -1,0 +1,45 @@
+"""Outputs must never land on inputs: the same file, however it is named."""
+import os
+
+from .errors import InputError
+
+
+def _identity(path):
+    """(real path, (device, inode) or None) of ``path``."""
+    real = os.path.realpath(path)
+    try:
+        st = os.stat(real)
+    except OSError:  # not there yet, or unreachable: the real path alone identifies it
+        return real, None
+    return real, (st.st_dev, st.st_ino)
+
+
+def refuse_overwriting_inputs(outputs, inputs):
+    """Raise :class:`InputError` when any of ``outputs`` is one of ``inputs``: the same real
+    path (``./in.obj``, an absolute path, a symbolic link) or the same file (a hard link).
+
+    Parameters
+    ----------
+    outputs : iterable of str, files the run would write
+    inputs : iterable of (what, path), e.g. ``("mesh", "in.obj")``
+
+    Examples
+    --------
+    >>> refuse_overwriting_inputs(["out.obj"], [("mesh", "in.obj")])
+    >>> refuse_overwriting_inputs(["./in.obj"], [("mesh", "in.obj")])
+    Traceback (most recent call last):
+    ...
+    srarap_cli.runtime.errors.InputError: ./in.obj: is the mesh (in.obj); refusing to overwrite an input
+    """
+    by_path, by_file = {}, {}
+    for what, path in inputs:
+        real, key = _identity(path)
+        by_path.setdefault(real, (what, path))
+        if key is not None:
+            by_file.setdefault(key, (what, path))
+    for out in outputs:
+        real, key = _identity(out)
+        hit = by_path.get(real) or (by_file.get(key) if key is not None else None)
+        if hit is not None:
+            what, path = hit
+            raise InputError(f"{out}: is the {what} ({path}); refusing to overwrite an input")
