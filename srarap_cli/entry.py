@@ -1,8 +1,9 @@
-"""The console entry point: signal handling first, then the command line.
+"""The console entry point: signal handling first, then the command line, then one way out.
 
-Installed before anything is imported, so that SIGINT or SIGTERM while Python is still
-loading modules ends the run with one line and the documented code, not a traceback or a
-silent death.
+Handlers are installed before anything else is imported, so that SIGINT or SIGTERM while
+Python is still loading modules ends the run with one line and the documented code. The
+process ends through :func:`srarap_cli.runtime.signals.exit_now`: no interpreter teardown, so
+neither a background thread nor a late signal can turn a finished run into a crash.
 """
 import sys
 
@@ -10,13 +11,26 @@ from .runtime import signals
 
 
 def main():
-    signals.install()
+    signals.own()
+    code = 1
     try:
         from .cli import main as command
+        command(prog_name="srarap")
+        code = 0
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        if not isinstance(exc.code, (int, type(None))):
+            sys.stderr.write(f"{exc.code}\n")
     except KeyboardInterrupt:
-        sys.stderr.write("srarap: error: interrupted; no output written\n")
-        sys.exit(130)
+        sys.stderr.write(f"srarap: error: interrupted; {_written()}\n")
+        code = 130
     except signals.Terminated:
-        sys.stderr.write("srarap: error: terminated; no output written\n")
-        sys.exit(143)
-    command(prog_name="srarap")
+        sys.stderr.write(f"srarap: error: terminated; {_written()}\n")
+        code = 143
+    signals.exit_now(code, lambda word: f"{word}; {_written()}")
+
+
+def _written():
+    """What had been committed (the command line's account of it, when it was loaded)."""
+    common = sys.modules.get("srarap_cli.cli.common")
+    return common.written() if common is not None else "no output written"

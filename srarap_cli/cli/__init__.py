@@ -52,6 +52,7 @@ class LazyGroup(click.Group):
         try:
             code = super().main(args, prog_name, complete_var, False, **extra)
         except signals.Terminated:  # before a command's own handling took over
+            signals.block()
             click.echo("srarap: error: terminated; no output written", err=True)
             sys.exit(143)
         except click.UsageError as exc:
@@ -62,6 +63,7 @@ class LazyGroup(click.Group):
             click.echo(f"srarap: error: {exc.format_message()}", err=True)
             sys.exit(exc.exit_code)
         except (click.Abort, KeyboardInterrupt):
+            signals.block()
             click.echo("srarap: error: interrupted; no output written", err=True)
             sys.exit(130)
         sys.exit(code if isinstance(code, int) else 0)

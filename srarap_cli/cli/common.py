@@ -12,13 +12,31 @@ from ..io.handles import referenced_files
 from ..runtime import exit_codes, signals
 from ..runtime.commit import COMMITTED
 from ..runtime.errors import InputError, NumericalError, OutputError, SingularSystemError
+from ..runtime.limits import is_out_of_memory, memory_note
 from ..runtime.paths import refuse_overwriting_inputs
 from ..runtime.signals import Terminated
 
 
 def fail(code, message):
-    click.echo(f"srarap: error: {message}", err=True)
+    """One line on stderr (a file name holding a newline is printed escaped) and ``code``."""
+    line = message.replace("\\", "\\\\").replace("\n", "\\n").replace("\r", "\\r")
+    try:
+        click.echo(f"srarap: error: {line}", err=True)
+    except OSError:  # stderr itself is gone: the exit code is all that can tell
+        pass
     sys.exit(code)
+
+
+def write_stdout(data):
+    """``data`` (bytes) to standard output; a full device or a closed pipe is an output error
+    and a broken pipe respectively, never an internal one."""
+    try:
+        sys.stdout.buffer.write(data)
+        sys.stdout.buffer.flush()
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        raise OutputError(f"<stdout>: cannot write: {exc.strerror or exc}") from None
 
 
 def guarded(func):
@@ -35,6 +53,10 @@ def guarded(func):
                 return func(*args, **kwargs)
         except (click.exceptions.Exit, click.ClickException, SystemExit):
             raise
+        except BrokenPipeError:
+            # the reader went away (``| head``): end quietly, as a process killed by SIGPIPE
+            _quiet_stdout()
+            sys.exit(exit_codes.BROKEN_PIPE)
         # the command's outermost boundary: anything unexpected still becomes one line and
         # exit code 1 (traceback with --debug), never a raw traceback in a user's pipeline
         except Exception as exc:  # noqa: BLE001
@@ -43,14 +65,25 @@ def guarded(func):
             code, text = _classify(exc)
             fail(code, text)
         except KeyboardInterrupt:
-            fail(exit_codes.INTERRUPTED, f"interrupted; {_written()}")
+            signals.block()
+            fail(exit_codes.INTERRUPTED, f"interrupted; {written()}")
         except Terminated:
-            fail(exit_codes.TERMINATED, f"terminated; {_written()}")
+            signals.block()
+            fail(exit_codes.TERMINATED, f"terminated; {written()}")
 
     return wrapper
 
 
-def _written():
+def _quiet_stdout():
+    """Point stdout at /dev/null: flushing what the closed pipe did not take would fail."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+
+
+def written():
     """What the run had committed when a signal stopped it (an animation's resume state is
     not named, but said to be there)."""
     files = list(dict.fromkeys(p for p in COMMITTED
@@ -67,6 +100,10 @@ def _written():
 def _classify(exc):
     if isinstance(exc, InputError):
         return exit_codes.INVALID_INPUT, str(exc)
+    if isinstance(exc, MemoryError) or is_out_of_memory(exc):
+        return exit_codes.INVALID_INPUT, (
+            "out of memory: the mesh is too large for the memory this process may use "
+            f"({memory_note()}); no output written")
     if isinstance(exc, OutputError):
         return exit_codes.OUTPUT_ERROR, str(exc)
     if isinstance(exc, NumericalError):

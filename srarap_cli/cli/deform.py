@@ -19,7 +19,7 @@ from ..solver.settings import complete, resolve
 from ..tasks.distortion import vertex_distortion
 from ..tasks.pipeline import deform_mesh
 from ..tasks.preview import preview_png
-from .common import cache_option, check_output_path, guarded, refuse_overwrite
+from .common import cache_option, check_output_path, guarded, refuse_overwrite, write_stdout
 from .options import settings_options
 from .progress import SolveProgress
 
@@ -92,8 +92,7 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
         files.append((log, format_log(result.log, os.path.splitext(log)[1].lower()).encode()))
     commit_files(files)
     if keep and out == "-":
-        sys.stdout.buffer.write(mesh_bytes)
-        sys.stdout.flush()
+        write_stdout(mesh_bytes)
     if not quiet:
         for note in notes + lost:
             click.echo(f"srarap: warning: {note}", err=True)

@@ -9,4 +9,5 @@ OUTPUT_ERROR = 6
 BEYOND_TOLERANCE = 7  # srarap compare: the meshes differ by more than --tol
 BATCH_FAILED = 8  # srarap batch: a job failed or regressed
 INTERRUPTED = 130  # SIGINT (Ctrl-C)
+BROKEN_PIPE = 141  # the reader of standard output went away (as a process killed by SIGPIPE)
 TERMINATED = 143  # SIGTERM

@@ -1,5 +1,13 @@
-"""Refuse work that would not fit in memory, early and with an estimate."""
+"""Refuse work that would not fit in memory, early and with an estimate; recognize running out.
+
+What srarap may plan to use is the least of: ``$SRARAP_MEMORY_LIMIT`` (bytes), the memory the
+system has available, the process's address-space limit (``ulimit -v``) and its cgroup's
+memory limit (a container's). Each later allocation that fails anyway (numpy, SuperLU, libigl,
+a worker thread) is reported as "out of memory" with exit code 4.
+"""
+import math
 import os
+import resource
 
 from .errors import InputError
 
@@ -9,21 +17,32 @@ from .errors import InputError
 READ_FACTOR = {".obj": 20, ".off": 20, ".ply": 6, ".stl": 6}
 SOLVE_BYTES_PER_VERTEX = 8_000
 ENV = "SRARAP_MEMORY_LIMIT"
+# an address space holds the interpreter and its libraries before any data: about 1 GB of
+# mappings for numpy, scipy, libigl and their BLAS before the first mesh is read
+ADDRESS_SPACE_BASE = 1_200_000_000
+# SuperLU and libigl report a failed allocation in their own words
+_OOM_WORDS = ("malloc", "out of memory", "not enough memory", "bad_alloc", "cannot allocate")
 
 
-def available_memory():
-    """Bytes srarap may plan to use: ``$SRARAP_MEMORY_LIMIT`` if set, else MemAvailable."""
-    if os.environ.get(ENV):
-        try:
-            return int(float(os.environ[ENV]))
-        except ValueError:
-            raise InputError(f"{ENV}={os.environ[ENV]!r}: expected a number of bytes") from None
+def _from_env():
+    text = os.environ[ENV].strip()
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value <= 0 or value > 2 ** 62 or len(text) > 19:
+        raise InputError(f"{ENV}={os.environ[ENV]!r}: expected a positive number of bytes "
+                         "(at most 4.6e18)")
+    return int(value)
+
+
+def _system_available():
     try:
         with open("/proc/meminfo") as fh:
             for line in fh:
                 if line.startswith("MemAvailable:"):
                     return int(line.split()[1]) * 1024
-    except OSError:  # no /proc (not Linux): ask the C library below
+    except (OSError, ValueError, IndexError):  # no /proc (not Linux): ask the C library
         pass
     try:
         return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
@@ -31,9 +50,60 @@ def available_memory():
         return None
 
 
+def _address_space():
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    return None if soft == resource.RLIM_INFINITY else max(soft - ADDRESS_SPACE_BASE, 0)
+
+
+def _cgroup():
+    """The cgroup v2 (or v1) memory limit less what the group uses, or None."""
+    for limit, usage in (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+                         ("/sys/fs/cgroup/memory/memory.limit_in_bytes",
+                          "/sys/fs/cgroup/memory/memory.usage_in_bytes")):
+        try:
+            with open(limit) as fh:
+                text = fh.read().strip()
+            if text == "max" or int(text) >= 2 ** 60:
+                return None
+            with open(usage) as fh:
+                used = int(fh.read().strip())
+            return max(int(text) - used, 0)
+        except (OSError, ValueError):
+            continue
+    return None
+
+
+def available_memory():
+    """Bytes srarap may plan to use (see the module's docstring), or None if unknown."""
+    if os.environ.get(ENV, "").strip():
+        return _from_env()
+    known = [v for v in (_system_available(), _address_space(), _cgroup()) if v is not None]
+    return min(known) if known else None
+
+
+def memory_note():
+    """Where the process's memory bound comes from, for messages."""
+    if os.environ.get(ENV, "").strip():
+        return f"{ENV}={os.environ[ENV].strip()}"
+    if _address_space() is not None:
+        return "ulimit -v"
+    if _cgroup() is not None:
+        return "the container's memory limit"
+    return "the memory available"
+
+
+def is_out_of_memory(exc):
+    """Whether ``exc`` is a failed allocation reported as something else (SuperLU's malloc
+    failures arrive as RuntimeError, C++'s bad_alloc as various types)."""
+    text = str(exc).lower()
+    return isinstance(exc, (RuntimeError, OSError, ValueError)) and any(
+        word in text for word in _OOM_WORDS) or (isinstance(exc, OSError) and exc.errno == 12)
+
+
 def _refuse(what, need, have):
     raise InputError(f"{what} needs about {need / 1e9:.1f} GB of memory, "
-                     f"{have / 1e9:.1f} GB available (set {ENV} to change the assumption)")
+                     f"{have / 1e9:.1f} GB available to it ({memory_note()}; set {ENV} to "
+                     "change the assumption)")
 
 
 def check_read(path):

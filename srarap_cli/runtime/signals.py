@@ -1,19 +1,105 @@
-"""SIGTERM as an exception, installed before anything slow is imported, so that a signal at
-any moment ends the run with one line and the documented code (SIGINT already raises
-KeyboardInterrupt)."""
+"""SIGINT and SIGTERM at any moment: one line, the documented code, the truth about outputs.
+
+Both signals are routed to exceptions (:class:`KeyboardInterrupt`, :class:`Terminated`) and
+recorded, so that a signal some library swallowed on its way (an import that turned it into an
+ImportError and was caught) is still reported. Compiled libraries are imported with the signals
+held back (:func:`deferred`): pybind11 modules turn a signal during their initialization into
+``ImportError: std::bad_cast``. The process ends through :func:`exit_now`, with the signals
+blocked and without the interpreter's teardown: a background thread still inside a
+factorization (multiresolution runs one beside the simplification) would otherwise crash the
+finalizing interpreter, and a signal during the teardown would be lost or print a traceback.
+"""
+import contextlib
+import os
 import signal
+import sys
 import threading
+
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+#: the first of SIGINT/SIGTERM this process received (0: none)
+RECEIVED = 0
+#: whether this process is the ``srarap`` command (:func:`own`), not a library's host
+OWNED = False
+CODES = {signal.SIGINT: 130, signal.SIGTERM: 143}
+WORDS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
 
 
 class Terminated(BaseException):
     """SIGTERM arrived; raised so that cleanup (temporary files) runs on the way out."""
 
 
-def _on_sigterm(_signum, _frame):
+def _on_signal(signum, _frame):
+    global RECEIVED
+    RECEIVED = RECEIVED or signum
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt()
     raise Terminated()
 
 
+def own():
+    """Take the signals for the ``srarap`` process (the console entry calls this first)."""
+    global OWNED
+    OWNED = True
+    install()
+
+
 def install():
-    """Route SIGTERM to :class:`Terminated` (main thread only: signals go there)."""
+    """Route SIGINT and SIGTERM to exceptions (main thread only: signals go there)."""
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _on_sigterm)
+        for signum in SIGNALS:
+            signal.signal(signum, _on_signal)
+
+
+@contextlib.contextmanager
+def deferred():
+    """Hold SIGINT/SIGTERM back inside the block; one that arrived is raised after it."""
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+
+
+def block():
+    """Hold SIGINT/SIGTERM back from now on (the ``srarap`` process is on its way out; in a
+    process that hosts srarap as a library, nothing changes)."""
+    if OWNED:
+        signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+
+
+def pending():
+    """The signal that arrived or is waiting (held back), or 0."""
+    waiting = [s for s in SIGNALS if s in signal.sigpending()]
+    return RECEIVED or (waiting[0] if waiting else 0)
+
+
+def exit_now(code, report=None):
+    """End the process with ``code``: signals blocked, streams flushed, no teardown.
+
+    A signal that arrived (even one swallowed on the way) or waits turns the code into 130 or
+    143 unless it is already one of them; ``report(word)`` then gives the line to print, e.g.
+    ``"terminated; no output written"``.
+    """
+    signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    _flush(sys.stdout)
+    signum = pending()
+    if signum and code not in CODES.values():
+        code = CODES[signum]
+        if report is not None:
+            _write(sys.stderr, f"srarap: error: {report(WORDS[signum])}\n")
+    _flush(sys.stderr)
+    os._exit(code)
+
+
+def _write(stream, text):
+    try:
+        stream.write(text)
+    except (OSError, ValueError):  # stderr closed or full: the exit code still tells
+        pass
+
+
+def _flush(stream):
+    try:
+        stream.flush()
+    except (OSError, ValueError):  # a closed pipe: what was not read is nobody's loss
+        pass

@@ -247,7 +247,8 @@ class Deformer:
         max_iter : int >= 0, local/global iterations at most
         tol : float, stop when the relative energy changes ``|E_k - E_{k-1}| / |E_{k-1}|``
             of the last 3 steps average at most ``tol`` (and the last step moved no vertex
-            by more than ``sqrt(tol)`` of the bounding-box diagonal; see
+            by more than ``sqrt(tol)`` of the diagonal of the box around the rest mesh and
+            the targets; see
             :mod:`srarap_cli.solver.drivers.monitor`)
         time_limit : float, optional; stop (not converged) once this many seconds have passed
         accel : {"anderson", "none"}, the driver: accelerated or plain iteration
@@ -264,9 +265,12 @@ class Deformer:
         """
         targets = api_checks.targets(targets, len(self.constrained))
         self.prepare()
+        # the move test's scale spans the targets too: a handle sent a thousand diagonals
+        # away moves vertices by more than the rest mesh's size in every converging step
+        extent = np.ptp(np.vstack([self.V.min(axis=0), self.V.max(axis=0), targets]), axis=0)
         monitor = Monitor(max_iter=max_iter, tol=tol, time_limit=time_limit,
                           callback=callback, energy_scale=self.energy_scale,
-                          scale=self.diagonal)
+                          scale=float(np.linalg.norm(extent)))
         step = self.step_for(targets, tol)
         first = STARTS["warm" if initial is not None else start](step, initial)
         if not callable(driver):

@@ -6,6 +6,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..runtime.errors import SingularSystemError
+from ..runtime.limits import is_out_of_memory
+from ..runtime.signals import deferred
 
 # Above this size SuperLU's minimum-degree ordering is what takes the time (on the 738k-vertex
 # Laplacian it had not finished after 12 minutes). METIS's nested dissection orders it in 7 s
@@ -43,6 +45,8 @@ def factor(A, symmetric):
         lu = spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A" if symmetric else "COLAMD",
                        options=options)
     except RuntimeError as exc:  # SuperLU reports an exactly singular matrix this way
+        if is_out_of_memory(exc):  # ... and a failed allocation too
+            raise MemoryError(str(exc)) from None
         raise SingularSystemError(str(exc)) from exc
     return lu.solve
 
@@ -83,7 +87,8 @@ def fill_order(A):
     -------
     (n,) int64 array, a permutation of ``range(n)``
     """
-    import pymetis
+    with deferred():  # a pybind11 module, as libigl (see solver.libigl)
+        import pymetis
 
     coo = sp.coo_matrix(A)
     off = coo.row != coo.col

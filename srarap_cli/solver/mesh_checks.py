@@ -1,6 +1,7 @@
 """Mesh problems the solve survives, reported as warnings with counts."""
-import igl
 import numpy as np
+
+from .libigl import igl
 
 NEEDLE_DEGREES = 1.0
 

@@ -1,11 +1,11 @@
 """Edge weights, cell adjacency and the Laplacian of a triangle mesh."""
 from dataclasses import dataclass
 
-import igl
 import numpy as np
 import scipy.sparse as sp
 
 from .group_rotations import label_sum
+from .libigl import igl
 from .settings import WEIGHT_KINDS
 
 # Half-cotangents are bounded: an angle under ~0.06 degrees (a needle) would otherwise give

@@ -8,10 +8,10 @@ import statistics
 import time
 from dataclasses import dataclass, field
 
-import igl
 import numpy as np
 
 from ..solver.deformer import Deformer
+from ..solver.libigl import igl
 
 ACCELERATED = "+anderson"
 SR_METHODS = ("sr-linear", "sr-linear-sym", "sr-relax", "sr-linear-sym" + ACCELERATED)

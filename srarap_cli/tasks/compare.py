@@ -1,6 +1,7 @@
 """How far apart two meshes are: per vertex when they share topology, else by surfaces."""
-import igl
 import numpy as np
+
+from ..solver.libigl import igl
 
 
 def same_topology(a, b):

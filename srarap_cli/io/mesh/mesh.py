@@ -41,7 +41,7 @@ class Mesh:
         """Fan triangulation for the solve: ``F`` (f, 3) and the polygon of each triangle."""
         if self.face_sizes.size and self.face_sizes.min() == self.face_sizes.max() == 3:
             return self.face_vertices.reshape(-1, 3), np.arange(self.face_sizes.size)
-        import igl  # loads scipy: not needed to read or write a file
+        from ...solver.libigl import igl  # loads scipy: not needed to read or write a file
 
         F, J = igl.polygons_to_triangles(self.face_vertices.astype(np.int64), self.face_offsets)
         return F, J

@@ -1,7 +1,8 @@
 """One factorization of the fine Laplacian with Dirichlet vertices, for many solves."""
-import igl
 import numpy as np
 import scipy.sparse as sp
+
+from ..libigl import igl
 
 
 class DirichletSolver:
