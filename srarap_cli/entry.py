@@ -22,9 +22,11 @@ def main():
         if not isinstance(exc.code, (int, type(None))):
             sys.stderr.write(f"{exc.code}\n")
     except KeyboardInterrupt:
+        signals.streams.release()
         sys.stderr.write(f"srarap: error: interrupted; {_written()}\n")
         code = 130
     except signals.Terminated:
+        signals.streams.release()
         sys.stderr.write(f"srarap: error: terminated; {_written()}\n")
         code = 143
     signals.exit_now(code, lambda word: f"{word}; {_written()}")

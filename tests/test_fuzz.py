@@ -196,3 +196,128 @@ def test_corrupted_input_never_crashes_or_leaves_partial_output(mesh, doc, suffi
             assert np.isfinite(written.vertices).all()
         else:
             assert sorted(os.listdir(folder)) == sorted(["m" + mesh[0], "h.yaml"])
+
+
+BUDGET = int(os.environ.get("SRARAP_FUZZ_EXAMPLES", "60"))
+SIDE_TOKENS = st.sampled_from(["0", "1", "2", "-1", "1e308", "-1e308", "nan", "inf", "a", "",
+                               "0 0", "1 16", "3.5", "1e200", "\xe9", "0 0 0 1"])
+
+
+@st.composite
+def side_files(draw):
+    """A handle file that names a .dmat, .sel or .def, with generated contents (binary .dmat
+    headers, wrong sizes, huge and non-finite entries, affine rows) and maybe a BOM."""
+    n = len(MESH.vertices)
+    kind = draw(st.sampled_from(["dmat", "dmat-binary", "sel", "def"]))
+    if kind == "dmat":
+        body = f"1 {n}\n" + "\n".join(draw(st.lists(SIDE_TOKENS, min_size=n - 1, max_size=n + 1)))
+        data, name = body.encode(), "g.dmat"
+    elif kind == "dmat-binary":
+        rows = draw(st.integers(-1, n + 1))
+        data = b"0 0\n" + f"1 {rows}\n".encode() + draw(st.binary(max_size=8 * (n + 2)))
+        name = "g.dmat"
+    elif kind == "sel":
+        data, name = "\n".join(draw(st.lists(SIDE_TOKENS, min_size=n - 1, max_size=n + 1))).encode(), "s.sel"
+    else:
+        data = "\n".join(" ".join(draw(st.lists(SIDE_TOKENS, min_size=4, max_size=4)))
+                         for _ in range(4)).encode()
+        name = "m.def"
+    status = draw(st.sampled_from(["fixed", "handle", ["a"], {}, 3]))
+    group = {"dmat": {"file": "g.dmat", "group": 0}} if name == "g.dmat" else \
+        {"sel": {"file": "s.sel", "status": status}} if name == "s.sel" else \
+        {"box": {"min": [-2, -2, 5.99], "max": [2, 2, 6.01]}, "matrix": "m.def"}
+    doc = {"groups": {"base": {"box": {"min": [-2, -2, -0.01], "max": [2, 2, 0.01]},
+                               "fixed": True},
+                      "g": {**group, **({} if "matrix" in group else {"fixed": True})}}}
+    bom = draw(st.booleans())
+    return name, (b"\xef\xbb\xbf" if bom else b"") + data, yaml.safe_dump(doc)
+
+
+@settings(max_examples=BUDGET, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(side=side_files(), bom_mesh=st.booleans(), bom_handles=st.booleans())
+def test_side_files_and_byte_order_marks_never_crash(side, bom_mesh, bom_handles):
+    name, data, doc = side
+    with tempfile.TemporaryDirectory() as folder:
+        mark = b"\xef\xbb\xbf"
+        with open(os.path.join(folder, "m.obj"), "wb") as fh:
+            fh.write(mark * bom_mesh + VALID[".obj"].encode())
+        with open(os.path.join(folder, name), "wb") as fh:
+            fh.write(data)
+        with open(os.path.join(folder, "h.yaml"), "wb") as fh:
+            fh.write(mark * bom_handles + doc.encode())
+        before = sorted(os.listdir(folder))
+        out = os.path.join(folder, "out.obj")
+        r = CliRunner().invoke(main, ["deform", os.path.join(folder, "m.obj"),
+                                      os.path.join(folder, "h.yaml"), "-o", out])
+        event(f"exit code {r.exit_code}")
+        assert r.exit_code in DOCUMENTED, r.output
+        if r.exit_code not in (0, 3):
+            assert r.stderr.count("\n") == 1 and r.stderr.startswith("srarap: error: ")
+            assert sorted(os.listdir(folder)) == before
+        if r.exit_code == 0:
+            assert len(read_mesh(out).vertices) == len(MESH.vertices)
+
+
+LOG_VALUES = st.sampled_from(["0", "1.5", "", "x", "nan", "inf", "-1", "1e400", "null", "[]"])
+
+
+@settings(max_examples=BUDGET, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(rows=st.lists(st.tuples(LOG_VALUES, LOG_VALUES, LOG_VALUES), min_size=0, max_size=4),
+       kind=st.sampled_from(["csv", "jsonl", "jsonl-list"]), bom=st.booleans())
+def test_plot_of_generated_logs_is_a_picture_or_one_line(rows, kind, bom):
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "log." + kind.split("-")[0])
+        if kind == "csv":
+            text = "iteration,total,seconds\n" + "".join(",".join(r) + "\n" for r in rows)
+        elif kind == "jsonl":
+            text = "".join("{" + ", ".join(f'"{k}": {v or chr(34) * 2}' for k, v in
+                                           zip(("iteration", "total", "seconds"), r)) + "}\n"
+                           for r in rows)
+        else:
+            text = "".join("[" + ", ".join(v or "0" for v in r) + "]\n" for r in rows)
+        with open(path, "wb") as fh:
+            fh.write(b"\xef\xbb\xbf" * bom + text.encode())
+        out = os.path.join(folder, "p.png")
+        r = CliRunner().invoke(main, ["plot", path, "-o", out])
+        event(f"exit code {r.exit_code}")
+        assert r.exit_code in (0, 4), r.output
+        assert os.path.exists(out) == (r.exit_code == 0)
+        if r.exit_code:
+            assert r.stderr.count("\n") == 1
+
+
+@settings(max_examples=max(BUDGET // 4, 10), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(alias=st.sampled_from(["same", "dot", "absolute", "hard", "soft"]),
+       which=st.sampled_from(["mesh", "handles", "dmat"]),
+       role=st.sampled_from(["-o", "--log", "--preview"]))
+def test_an_output_naming_an_input_in_any_way_is_refused(alias, which, role):
+    with tempfile.TemporaryDirectory() as folder:
+        mesh = os.path.join(folder, "m.obj")
+        with open(mesh, "w") as fh:
+            fh.write(VALID[".obj"])
+        with open(os.path.join(folder, "g.dmat"), "w") as fh:
+            fh.write(f"1 {len(MESH.vertices)}\n" + "0\n" * len(MESH.vertices))
+        doc = yaml.safe_load(yaml.safe_dump(HANDLES))
+        doc["groups"]["tip"]["dmat"] = {"file": "g.dmat", "group": 1}
+        with open(os.path.join(folder, "h.yaml"), "w") as fh:
+            yaml.safe_dump(doc, fh)
+        target = {"mesh": mesh, "handles": os.path.join(folder, "h.yaml"),
+                  "dmat": os.path.join(folder, "g.dmat")}[which]
+        ext = {"-o": ".obj", "--log": ".csv", "--preview": ".png"}[role]
+        name = os.path.join(folder, "alias" + ext)
+        if alias in ("same", "dot", "absolute"):
+            os.symlink(target, name)  # a name with the role's extension for the same file
+        elif alias == "hard":
+            os.link(target, name)
+        else:
+            os.symlink(os.path.relpath(target, folder), name)
+        given_name = {"dot": os.path.join(folder, ".", "alias" + ext)}.get(alias, name)
+        contents = {p: open(os.path.join(folder, p), "rb").read() for p in os.listdir(folder)}
+        args = ["deform", mesh, os.path.join(folder, "h.yaml"), "-o",
+                os.path.join(folder, "o.obj")]
+        args = args[:4] + [given_name] if role == "-o" else args + [role, given_name]
+        r = CliRunner().invoke(main, args)
+        assert r.exit_code == 4 and "refusing to overwrite an input" in r.stderr, r.output
+        assert {p: open(os.path.join(folder, p), "rb").read()
+                for p in os.listdir(folder)} == contents

@@ -8,7 +8,7 @@ import sys
 
 import click
 
-from ..runtime import signals
+from ..runtime import signals, streams
 from ..runtime.threads import pin_process
 
 #: name -> (module, function, one-line help shown by ``srarap --help``)
@@ -53,6 +53,7 @@ class LazyGroup(click.Group):
             code = super().main(args, prog_name, complete_var, False, **extra)
         except signals.Terminated:  # before a command's own handling took over
             signals.block()
+            streams.release()
             click.echo("srarap: error: terminated; no output written", err=True)
             sys.exit(143)
         except click.UsageError as exc:
@@ -64,6 +65,7 @@ class LazyGroup(click.Group):
             sys.exit(exc.exit_code)
         except (click.Abort, KeyboardInterrupt):
             signals.block()
+            streams.release()
             click.echo("srarap: error: interrupted; no output written", err=True)
             sys.exit(130)
         sys.exit(code if isinstance(code, int) else 0)

@@ -9,7 +9,7 @@ import click
 import numpy as np
 
 from ..io.handles import referenced_files
-from ..runtime import exit_codes, signals
+from ..runtime import exit_codes, signals, streams
 from ..runtime.commit import COMMITTED
 from ..runtime.errors import InputError, NumericalError, OutputError, SingularSystemError
 from ..runtime.limits import is_out_of_memory, memory_note
@@ -19,7 +19,8 @@ from ..runtime.signals import Terminated
 
 def fail(code, message):
     """One line on stderr (a file name holding a newline is printed escaped) and ``code``."""
-    line = message.replace("\\", "\\\\").replace("\n", "\\n").replace("\r", "\\r")
+    streams.release()
+    line = message.replace("\n", "\\n").replace("\r", "\\r")
     try:
         click.echo(f"srarap: error: {line}", err=True)
     except OSError:  # stderr itself is gone: the exit code is all that can tell
@@ -103,15 +104,15 @@ def _classify(exc):
     if isinstance(exc, MemoryError) or is_out_of_memory(exc):
         return exit_codes.INVALID_INPUT, (
             "out of memory: the mesh is too large for the memory this process may use "
-            f"({memory_note()}); no output written")
+            f"({memory_note()}); {written()}")
     if isinstance(exc, OutputError):
         return exit_codes.OUTPUT_ERROR, str(exc)
     if isinstance(exc, NumericalError):
-        return exit_codes.NUMERICAL_FAILURE, f"{exc}; no output written"
+        return exit_codes.NUMERICAL_FAILURE, f"{exc}; {written()}"
     if isinstance(exc, SingularSystemError | np.linalg.LinAlgError):
         return exit_codes.NUMERICAL_FAILURE, (
             f"singular system ({exc}): degenerate geometry (coincident or collinear vertices, "
-            "zero-area triangles) or a part with no constraint; no output written")
+            f"zero-area triangles) or a part with no constraint; {written()}")
     return exit_codes.INTERNAL_ERROR, (f"internal error: {type(exc).__name__}: {exc} "
                                        "(rerun with --debug for the traceback and report it)")
 

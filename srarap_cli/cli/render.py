@@ -1,6 +1,7 @@
 """``srarap render`` and ``srarap plot``: pictures of meshes and of energy logs."""
 import csv
 import json
+import math
 import os
 
 import click
@@ -91,10 +92,10 @@ def plot(logs, out, size):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    tables = [(path, _read_log(path)) for path in logs]  # every log checked before drawing
     fig, (a, b) = plt.subplots(1, 2, figsize=(w / 100, h / 100), dpi=100)
-    for path in logs:
-        rows = _read_log(path)
-        it = [int(r["iteration"]) for r in rows]
+    for path, rows in tables:
+        it = [float(r["iteration"]) for r in rows]
         e = [float(r["total"]) for r in rows]
         t = [max(float(r["seconds"]), 1e-4) for r in rows]
         a.semilogy(it, e, label=os.path.basename(path))
@@ -122,6 +123,22 @@ def _read_log(path):
                 rows = [json.loads(line) for line in fh if line.strip()]
     except (OSError, ValueError) as exc:
         raise InputError(f"{path}: not a readable log ({exc})") from None
-    if not rows or not {"iteration", "total", "seconds"} <= set(rows[0]):
-        raise InputError(f"{path}: not a srarap deform log (needs iteration, total, seconds)")
+    fields = ("iteration", "total", "seconds")
+    if not rows or not all(isinstance(r, dict) and set(fields) <= set(r) for r in rows):
+        raise InputError(f"{path}: not a srarap deform log (every row needs iteration, total, "
+                         "seconds)")
+    for k, row in enumerate(rows):
+        try:
+            if not all(math.isfinite(float(row[f])) for f in fields):
+                raise ValueError
+        except (TypeError, ValueError):
+            bad = next(f for f in fields if not _number(row[f]))
+            raise InputError(f"{path}: row {k + 1}: {bad} is not a number") from None
     return rows
+
+
+def _number(value):
+    try:
+        return math.isfinite(float(value))
+    except (TypeError, ValueError):
+        return False

@@ -38,6 +38,9 @@ def open_input(path, mode="r", **kwargs):
         raise InputError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise InputError(f"{path}: is a folder, not a file") from None
+    except UnicodeEncodeError:
+        raise InputError(f"{path!a}: the name cannot be encoded in this locale's file-name "
+                         "encoding (set LC_ALL=C.UTF-8 or PYTHONUTF8=1)") from None
     except OSError as exc:
         raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from None
     try:

@@ -17,9 +17,11 @@ from .errors import InputError
 READ_FACTOR = {".obj": 20, ".off": 20, ".ply": 6, ".stl": 6}
 SOLVE_BYTES_PER_VERTEX = 8_000
 ENV = "SRARAP_MEMORY_LIMIT"
-# an address space holds the interpreter and its libraries before any data: about 1 GB of
-# mappings for numpy, scipy, libigl and their BLAS before the first mesh is read
-ADDRESS_SPACE_BASE = 1_200_000_000
+#: coordinates beyond this would overflow when squared (energies, lengths): a typo, not a pose
+MAX_COORDINATE = 1e150
+# an address space holds the interpreter and its libraries before any data: 205-290 MB of
+# mappings (VmSize) once numpy, scipy, libigl, yaml and click are loaded
+ADDRESS_SPACE_BASE = 300_000_000
 # SuperLU and libigl report a failed allocation in their own words
 _OOM_WORDS = ("malloc", "out of memory", "not enough memory", "bad_alloc", "cannot allocate")
 

@@ -15,6 +15,8 @@ import signal
 import sys
 import threading
 
+from . import streams
+
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 #: the first of SIGINT/SIGTERM this process received (0: none)
 RECEIVED = 0
@@ -81,13 +83,15 @@ def exit_now(code, report=None):
     ``"terminated; no output written"``.
     """
     signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    streams.release()
     _flush(sys.stdout)
-    signum = pending()
+    _flush(sys.stderr)
+    signum = pending()  # the last look: from here to the exit takes microseconds
     if signum and code not in CODES.values():
         code = CODES[signum]
         if report is not None:
             _write(sys.stderr, f"srarap: error: {report(WORDS[signum])}\n")
-    _flush(sys.stderr)
+            _flush(sys.stderr)
     os._exit(code)
 
 

@@ -32,9 +32,32 @@ def single_threaded(func):
 
 def pin_process():
     """Ask the BLAS libraries for one thread before they load (the command line calls this
-    first; libraries already loaded keep their pools, which :func:`single_threaded` limits)."""
+    first; libraries already loaded keep their pools, which :func:`single_threaded` limits),
+    and keep threads in the main malloc arena under an address-space limit."""
     for name in _VARIABLES:
         os.environ[name] = "1"
+    _one_arena_under_address_limit()
+
+
+# glibc's mallopt parameter M_ARENA_MAX
+_M_ARENA_MAX = -8
+
+
+def _one_arena_under_address_limit():
+    """Under ``ulimit -v``, each new thread's malloc arena reserves 64-128 MB of address space;
+    when that fails glibc retries on every allocation (seen: libigl's worker threads spinning
+    in system time for minutes, then "cannot allocate memory for thread-local data: ABORT").
+    With a single arena the threads share the main one and a real shortage is a MemoryError."""
+    import resource
+
+    if resource.getrlimit(resource.RLIMIT_AS)[0] == resource.RLIM_INFINITY:
+        return
+    try:
+        import ctypes
+
+        ctypes.CDLL(None).mallopt(_M_ARENA_MAX, 1)
+    except (OSError, AttributeError):  # not glibc: no per-thread arenas to bound
+        pass
 
 
 def background(func):

@@ -8,6 +8,7 @@ import scipy.sparse.linalg as spla
 from ..runtime.errors import SingularSystemError
 from ..runtime.limits import is_out_of_memory
 from ..runtime.signals import deferred
+from ..runtime.streams import held_c_stderr
 
 # Above this size SuperLU's minimum-degree ordering is what takes the time (on the 738k-vertex
 # Laplacian it had not finished after 12 minutes). METIS's nested dissection orders it in 7 s
@@ -16,6 +17,27 @@ from ..runtime.signals import deferred
 # 184k vertices). Below, minimum degree is as good or better (46k: 0.38 s factor, 24 ms solve;
 # nested dissection 0.55 s, 23 ms).
 LARGE = 200_000
+
+
+def _warm_blas():
+    """Have OpenBLAS take its work buffer now, while memory is free.
+
+    OpenBLAS allocates that buffer (32 MB) on its first use and, when the allocation fails,
+    retries forever: under ``ulimit -v`` a SuperLU factorization reaching its first BLAS call
+    with the address space nearly used spun at full CPU instead of failing (seen: minutes,
+    deaf to SIGTERM). A buffer taken early is reused by every later call."""
+    import resource
+
+    if resource.getrlimit(resource.RLIMIT_AS)[0] == resource.RLIM_INFINITY:
+        return
+    from scipy.linalg import blas
+
+    one = np.ones((1, 1), order="F")
+    blas.dtrsv(one, np.ones(1))
+    blas.dgemm(1.0, one, one)
+
+
+_warm_blas()
 
 
 def factor(A, symmetric):
@@ -41,24 +63,28 @@ def factor(A, symmetric):
     if symmetric and A.shape[0] > LARGE:
         return _nested_dissection(A)
     options = {"SymmetricMode": True} if symmetric else {}
+    return _superlu(sp.csc_matrix(A), "MMD_AT_PLUS_A" if symmetric else "COLAMD",
+                    options).solve
+
+
+def _superlu(A, permc_spec, options):
+    """``splu`` with its failures as our errors. SuperLU prints a failed allocation on the C
+    stderr itself ("malloc fails for local dworkptr[]."): that text is held back and dropped
+    when the failure is reported as one line anyway."""
     try:
-        lu = spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A" if symmetric else "COLAMD",
-                       options=options)
+        with held_c_stderr():
+            return spla.splu(A, permc_spec=permc_spec, options=options)
     except RuntimeError as exc:  # SuperLU reports an exactly singular matrix this way
         if is_out_of_memory(exc):  # ... and a failed allocation too
             raise MemoryError(str(exc)) from None
         raise SingularSystemError(str(exc)) from exc
-    return lu.solve
 
 
 def _nested_dissection(A):
     """SuperLU of a symmetric ``A`` in METIS's nested dissection order: ``solve(b)``."""
     order = fill_order(A)
     permuted = sp.csc_matrix(sp.csr_matrix(A)[order][:, order])
-    try:
-        lu = spla.splu(permuted, permc_spec="NATURAL", options={"SymmetricMode": True})
-    except RuntimeError as exc:
-        raise SingularSystemError(str(exc)) from exc
+    lu = _superlu(permuted, "NATURAL", {"SymmetricMode": True})
 
     def solve(b):
         B = np.asarray(b, dtype=float)

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...runtime.errors import InputError
+from ...runtime.limits import MAX_COORDINATE
 from ...solver.settings import parse_mapping
 from ..documents import load_document
 from .fields import Context
@@ -167,7 +168,7 @@ def _from_sel(path, V):
             raise InputError(f"{def_path}: no such file (the .def that goes with {path})")
         M = read_def(def_path)
         t[handle] = V[handle] @ M[:3, :3].T + M[:3, 3]
-        if not np.isfinite(t[handle]).all():
+        if not np.isfinite(t[handle]).all() or np.abs(t[handle]).max() > MAX_COORDINATE:
             raise InputError(f"{def_path}: sends handle vertices to infinite or NaN positions "
                              "(entries too large)")
     ids = np.flatnonzero(status != 1)

@@ -56,13 +56,21 @@ def read_dmat(path):
         raise InputError(f"{path}: missing 'cols rows' header of a .dmat file") from None
     if (cols, rows) == (0, 0):  # binary variant: a second header, then raw doubles
         line, _, raw = body.partition(b"\n")
-        cols, rows = map(int, line.split()[:2])
+        try:
+            cols, rows = (int(w) for w in line.split()[:2])
+        except ValueError:
+            cols = rows = -1
+        if cols < 0 or rows < 0 or len(raw) < 8 * cols * rows:
+            raise InputError(f"{path}: binary .dmat needs a 'cols rows' second header and "
+                             "8 bytes per value")
         values = np.frombuffer(raw[:8 * cols * rows], dtype="<f8")
     else:
         try:
             values = np.array(body.split(), dtype=float)
         except ValueError:
             raise InputError(f"{path}: non-numeric entry") from None
+    if cols < 0 or rows < 0 or not np.isfinite(values).all():
+        raise InputError(f"{path}: negative sizes or non-finite values")
     if cols != 1 or values.size != rows:
         raise InputError(f"{path}: expected one column of {rows} values, "
                          f"found {values.size} values in {cols} column(s)")

@@ -54,7 +54,7 @@ def _dmat(ctx, spec, V, base):
 
 def _sel(ctx, spec, V, base):
     spec = ctx.record(spec, "sel", ("file", "status"))
-    if spec["status"] not in SEL_STATUS:
+    if not isinstance(spec["status"], str) or spec["status"] not in SEL_STATUS:
         raise ctx.error("sel status must be one of fixed, free, handle")
     path = _file(ctx, base, spec["file"], "sel file")
     return np.flatnonzero(_checked_length(ctx, read_sel(path), V, path)

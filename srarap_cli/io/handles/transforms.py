@@ -3,6 +3,7 @@ import os
 
 import numpy as np
 
+from ...runtime.limits import MAX_COORDINATE
 from ...solver.quaternion import from_axis_angle, to_matrix
 from .formats import read_def
 
@@ -44,9 +45,10 @@ def targets(ctx, spec, rest, base):
     4x4 matrix given inline or as the path of a ``.def`` file.
     """
     out = _moved(ctx, spec, rest, base)
-    if not np.isfinite(out).all():
-        raise ctx.error("the action sends vertices to infinite or NaN positions (entries too "
-                        "large)")
+    if not np.isfinite(out).all() or np.abs(out).max(initial=0) > MAX_COORDINATE:
+        where = f" ({spec['matrix']})" if isinstance(spec.get("matrix"), str) else ""
+        raise ctx.error(f"the action{where} sends vertices beyond {MAX_COORDINATE:g} or to "
+                        "infinite/NaN positions (entries too large)")
     return out
 
 

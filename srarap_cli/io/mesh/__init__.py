@@ -15,7 +15,7 @@ import numpy as np
 
 from ...runtime.commit import atomic_write
 from ...runtime.errors import InputError, OutputError
-from ...runtime.limits import check_read
+from ...runtime.limits import MAX_COORDINATE, check_read
 from ..input_files import open_input
 from .mesh import Mesh
 from .normals import recompute_normals
@@ -107,6 +107,10 @@ def _validate(mesh, path):
     if not np.isfinite(mesh.vertices).all():
         bad = int(np.flatnonzero(~np.isfinite(mesh.vertices).all(axis=1))[0])
         raise InputError(f"{path}: vertex {bad} has a NaN or infinite coordinate")
+    huge = np.abs(mesh.vertices).max(axis=1) > MAX_COORDINATE
+    if huge.any():
+        raise InputError(f"{path}: vertex {int(np.flatnonzero(huge)[0])} has a coordinate "
+                         f"beyond {MAX_COORDINATE:g} (its square would overflow); rescale the mesh")
     fv = mesh.face_vertices
     if fv.min() < 0 or fv.max() >= n:
         raise InputError(f"{path}: a face references vertex "

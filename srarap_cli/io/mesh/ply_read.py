@@ -171,6 +171,8 @@ def _uniform_rows(body, at, order, count, props):
             if pos + np.dtype(t[0]).itemsize > len(body):
                 return None
             n = int(np.frombuffer(body, order + t[0], 1, pos)[0])
+            if n < 0 or pos + n * np.dtype(t[1]).itemsize > len(body):
+                return None  # the entry-by-entry reader names the entry cut off
             fields += [(p + "#n", order + t[0]), (p, order + t[1], (n,))]
             pos += np.dtype(t[0]).itemsize + n * np.dtype(t[1]).itemsize
         else:
