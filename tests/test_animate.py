@@ -38,7 +38,7 @@ def run_frames(mesh, doc, n, feedback, iters=20):
     c = parse_handles(doc, mesh.vertices)
     frames = []
     state = Animator(mesh, c, resolve({}, {"feedback": feedback})).run(
-        n, iters_per_frame=iters, tol=1e-6, on_frame=lambda f, P, s: frames.append(P))
+        n, max_iter=iters, tol=1e-6, on_frame=lambda f, P, s: frames.append(P))
     return c, frames, state.rows
 
 
@@ -68,7 +68,7 @@ def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames(rings, multir
     frames = []
     animator = Animator(mesh, c, resolve({}, {"multires": multires}))
     assert (multires == "off") == (animator.deformer.__class__.__name__ == "Deformer")
-    animator.run(4, iters_per_frame=3000, tol=1e-13, on_frame=lambda f, P, s: frames.append(P))
+    animator.run(4, max_iter=3000, tol=1e-13, on_frame=lambda f, P, s: frames.append(P))
     q1 = from_axis_angle([1, 1, 0], 90)
     for f, P in enumerate(frames):
         t = f / 3
@@ -78,7 +78,9 @@ def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames(rings, multir
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("extra", [[], ["--multires", "150"]])
+# the multires case runs a fixed budget: on a 150-vertex coarse level the 360-degree frame does
+# not converge (it did not before the warm start spread the handles' change either)
+@pytest.mark.parametrize("extra", [[], ["--multires", "150", "--iters-per-frame", "20"]])
 def test_sequence_is_deterministic_and_resume_after_a_kill_gives_the_same_files(tmp_path, extra):
     ref, cut = tmp_path / "ref", tmp_path / "cut"
     base = [sys.executable, "-m", "srarap_cli", "animate", BAR, TWIST, "-q", *extra]
@@ -158,4 +160,5 @@ def test_progress_shows_on_a_terminal_and_stays_quiet_in_a_pipe(tmp_path):
     text = stderr_on_a_terminal(cmd, timeout=120)
     assert "frame 5/5" in text and "frames/s" in text and "ETA" in text
     piped = subprocess.run(cmd, capture_output=True, text=True, check=True)
-    assert "frame 5/5" not in piped.stderr and "srarap animate: 5 frames" in piped.stderr
+    assert "frame 5/5" not in piped.stderr
+    assert "srarap animate: 5 of 5 frames converged" in piped.stderr

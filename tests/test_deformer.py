@@ -212,7 +212,7 @@ def test_warm_start_from_a_converged_result_stays_put(bar):
     T = bend_targets(V, ids)
     first = d.solve(T, max_iter=500, tol=1e-9)
     again = d.solve(T, initial=(first.positions, first.rotors), max_iter=5, tol=1e-6)
-    assert again.converged and again.iterations == 1
+    assert again.converged and again.iterations == 3  # the stopping test's full window
     assert np.abs(again.positions - first.positions).max() < 1e-5
 
 

@@ -37,8 +37,11 @@ def test_a_run_whose_changes_settle_stops_once_the_window_averages_below_tol():
     assert converged and stopped == len(energies) - 1 == 2 + WINDOW
 
 
-def test_a_warm_start_at_the_answer_stops_after_one_step():
-    assert run([5.0, 5.0]) == (1, True)
+def test_a_warm_start_at_the_answer_stops_after_a_full_window():
+    """A first small step alone does not stop a run: across an animation such one-step stops
+    added up (see the monitor's docstring)."""
+    assert run([5.0, 5.0]) == (None, False)
+    assert run([5.0] * (WINDOW + 1)) == (WINDOW, True)
 
 
 def test_an_exact_answer_stops_even_though_its_relative_changes_are_noise():

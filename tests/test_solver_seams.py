@@ -69,7 +69,7 @@ def test_a_start_registered_from_a_test_file_is_used(bent):
     finally:
         STARTS.pop("test-answer")
     assert again.log[0]["total"] == pytest.approx(solved.log[-1]["total"], rel=1e-12)
-    assert again.converged and again.iterations <= 2
+    assert again.converged and again.iterations <= 3  # one full window of the stopping test
 
 
 def test_one_step_is_a_function_of_the_state(bent):

@@ -11,6 +11,7 @@ import click
 from ..io.handles import load_handles, referenced_files
 from ..io.mesh import WRITE_FORMATS, format_mesh, read_mesh
 from ..io.solve_log import LOG_FORMATS, format_log
+from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..runtime.errors import InputError, OutputError
 from ..runtime.limits import check_solve
@@ -35,22 +36,28 @@ MAX_FRAMES = 100_000
 @click.option("--max-frames", type=click.IntRange(min=1), default=MAX_FRAMES, show_default=True,
               help="Refuse an animation of more frames than this (a typo in --fps or a "
                    "keyframe time would otherwise fill the disk); raise it on purpose.")
-@click.option("--iters-per-frame", type=click.IntRange(min=1), default=20, show_default=True,
-              help="Local/global iterations per frame at most.")
+@click.option("--iters-per-frame", type=click.IntRange(min=1),
+              help="Fixed budget (real-time mode): at most N iterations per frame, and a "
+                   "frame that stops short of --tol is written all the same (exit code 0). "
+                   "[default: every frame iterates to --tol, at most --max-iter]")
+@click.option("--keep-unconverged", is_flag=True,
+              help="Write a frame that did not converge and go on (exit code still 3).")
 @click.option("--log", "log", help="Per-frame log: .csv or .jsonl.")
 @click.option("--resume", is_flag=True, help="Continue after the last complete frame.")
 @settings_options(exclude=("time_limit",))
 @cache_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress, summary or warnings.")
 @guarded
-def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, log, resume,
-            overrides, cache, quiet):
+def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, keep_unconverged,
+            log, resume, overrides, cache, quiet):
     """Deform MESH through the keyframes of HANDLES, writing one mesh per frame.
 
-    Each frame starts from the previous one (positions and rotors) and iterates until --tol or
-    --iters-per-frame. Frames are written atomically; --resume continues an interrupted run
-    and gives the same files as an uninterrupted one. Exit code 0 when every frame is written
-    (frames that hit --iters-per-frame are flagged in the log).
+    Each frame starts from the frames before it and iterates to --tol (at most --max-iter
+    iterations). Frames are written atomically; --resume continues an interrupted run and
+    gives the same files as an uninterrupted one. Exit codes: 0 every frame converged and was
+    written; 3 a frame did not converge: the sequence stops before it (frames so far and the
+    log are written; --keep-unconverged writes it and goes on). With --iters-per-frame N
+    (fixed budget) every frame is written and the exit code is 0.
     """
     folder = _check_pattern(pattern)
     if log is not None:
@@ -74,27 +81,48 @@ def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, lo
         commit_files([(pattern.format(f), data), (state_path, st.to_bytes())])
         progress.update(f + 1)
 
-    final = animator.run(n_frames, iters_per_frame=iters_per_frame, tol=opts.tol,
+    budget = iters_per_frame is not None
+    final = animator.run(n_frames, max_iter=iters_per_frame if budget else opts.max_iter,
+                         tol=opts.tol, stop_unconverged=not (budget or keep_unconverged),
                          state=state, on_frame=write_frame, fingerprint=run_id)
     progress.close()
     rows = final.rows if final is not None else []
+    if animator.stopped_at is not None:
+        rows = rows + [animator.stopped_row]
     if log is not None:
         text = format_log(rows, os.path.splitext(log)[1].lower(), FRAME_FIELDS)
         commit_files([(log, text.encode())])
-    os.unlink(state_path) if os.path.exists(state_path) else None
+    stopped = animator.stopped_at
+    if stopped is None and os.path.exists(state_path):
+        os.unlink(state_path)
     if not quiet:
         for line in animator.last_result.report_lines() if animator.last_result else []:
             click.echo(line, err=True)
-        stalled = sum(not r["converged"] for r in rows)
-        seconds = sum(r["seconds"] for r in rows)
-        first = 0 if state is None else state.frame + 1
-        wrote = (f"wrote {pattern.format(first)} .. {pattern.format(n_frames - 1)}"
-                 if first < n_frames else "nothing left to write")
-        if first:
-            wrote += f" (frames 0-{first - 1} were kept from the interrupted run)"
-        click.echo(f"srarap animate: {len(rows)} frames ({stalled} stopped at "
-                   f"--iters-per-frame {iters_per_frame}); {len(rows) / max(seconds, 1e-9):.2f} "
-                   f"frames/s; {wrote}", err=True)
+        click.echo(_summary(rows, state, n_frames, pattern, stopped, iters_per_frame, opts),
+                   err=True)
+    unconverged = sum(not r["converged"] for r in rows)
+    if unconverged and not budget:
+        raise SystemExit(exit_codes.NOT_CONVERGED)
+
+
+def _summary(rows, state, n_frames, pattern, stopped, budget, opts):
+    first = 0 if state is None else state.frame + 1
+    last = n_frames - 1 if stopped is None else stopped - 1
+    wrote = (f"wrote {pattern.format(first)} .. {pattern.format(last)}" if first <= last
+             else "nothing left to write" if stopped is None else "no frame written")
+    if first:
+        wrote += f" (frames 0-{first - 1} were kept from the interrupted run)"
+    converged = sum(r["converged"] for r in rows)
+    seconds = sum(r["seconds"] for r in rows)
+    its = sorted(r["iterations"] for r in rows)
+    head = (f"srarap animate: {converged} of {len(rows)} frames converged"
+            + (f" (fixed budget of {budget} iterations a frame)" if budget else "")
+            + (f", median {its[len(its) // 2]} iterations" if its else "")
+            + f"; {len(rows) / max(seconds, 1e-9):.2f} frames/s; {wrote}")
+    if stopped is not None:
+        head += (f"; STOPPED at frame {stopped}: not converged in {opts.max_iter} iterations "
+                 "(raise --max-iter, or --keep-unconverged writes it and goes on)")
+    return head
 
 
 def _frame_count(frames, last_key_frame, max_frames, handles):

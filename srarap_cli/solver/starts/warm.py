@@ -1,10 +1,23 @@
-"""Warm start: the caller's positions and rotors (a previous solve, the previous frame)."""
+"""Warm start: the caller's positions and rotors (a previous solve, the previous frame), with
+the handles' change since then spread over the mesh.
+
+Moving only the constrained vertices to their new targets puts a kink at every handle's
+boundary: a tube twisted 3 degrees further from its converged 30-degree pose started at 1.39x
+the final energy and took 17 iterations to the stop, against 11 from the cold (harmonic)
+start. Here each handle group's rotation since the previous state (its best fit from the
+previous positions of its vertices to their targets) is spread harmonically, as the cold start
+spreads the rest-to-target rotations, and composed with the previous rotors; the positions
+follow from one global step. When the targets did not change, that is the previous state
+after one more global step.
+"""
 import numpy as np
+
+from ..quaternion import IDENTITY, multiply, normalize
+from .harmonic import handle_rotors
 
 
 def warm_start(step, initial):
-    """Start from ``initial = (positions (n, 3), rotors (n, 4))``, constrained vertices moved
-    to their targets.
+    """Start from ``initial = (positions (n, 3), rotors (n, 4))`` moved by the handles' change.
 
     Returns
     -------
@@ -14,5 +27,10 @@ def warm_start(step, initial):
         raise ValueError("the warm start needs initial=(positions, rotors)")
     P = np.array(initial[0], dtype=float)
     R = np.array(initial[1], dtype=float)
-    P[step.deformer.fixed] = step.fixed_targets
-    return step.state(P, R)
+    d = step.deformer
+    held = np.tile(IDENTITY, (d.fixed.size, 1))
+    held[d.constrained_slots] = handle_rotors(P[d.constrained], step.targets, d.labels)
+    change = d.poisson.bind(held)(np.zeros((len(d.V), 4)))
+    change = normalize(change, np.broadcast_to(IDENTITY, change.shape))
+    R = normalize(multiply(change, R), R)
+    return step.state(step.positions(R), R)
