@@ -69,7 +69,9 @@ def test_every_output_format_keeps_vertex_order(small, tmp_path, suffix):
     mesh, handles = small
     out = tmp_path / f"out{suffix}"
     r = run(mesh, handles, "-o", out, "--max-iter", 5, "-q", "--keep-unconverged")
-    assert r.exit_code == 3 and r.stderr == ""  # 5 iterations do not converge; quiet
+    assert r.exit_code == 3  # 5 iterations do not converge
+    # quiet: warnings only (PLY drops the bar's seamed UVs), no summary line
+    assert all(line.startswith("srarap: warning: ") for line in r.stderr.splitlines())
     a, b = read_mesh(str(mesh)), read_mesh(str(out))
     assert len(b.vertices) == len(a.vertices)
     assert np.array_equal(b.face_vertices, a.face_vertices)
@@ -84,7 +86,7 @@ def test_jsonl_log_and_option_override(small, tmp_path):
     assert [row["iteration"] for row in rows] == [0, 1, 2, 3, 4]
     assert rows[0]["rel_change"] is None
     assert all(row["total"] == row["membrane"] + row["bending"] for row in rows)
-    assert r.exit_code == 3 and "NOT converged after 4 iterations" in r.stderr
+    assert r.exit_code == 3 and "NOT converged after 4 full-resolution iterations" in r.stderr
 
 
 def test_solver_settings_in_file_apply_unless_overridden(small, tmp_path):

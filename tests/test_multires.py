@@ -192,10 +192,11 @@ def test_multires_settings_parse_and_pick_the_direct_solve_for_small_meshes():
 def test_cli_multires_runs_caches_and_gives_identical_files(tmp_path):
     runner = CliRunner()
     args = ["deform", SPOT, NOD, "--multires", "1000", "--cache", str(tmp_path / "cache"),
-            "--max-iter", "40", "--multires-mode", "transfer"]
+            "--max-iter", "40", "--multires-mode", "transfer", "-v"]
     one = runner.invoke(main, args + ["-o", str(tmp_path / "a.obj")])
     assert one.exit_code in (0, 3), one.output
-    assert "srarap: multires: " in one.output and "full energy" in one.output
+    assert "srarap: multires: " in one.output and "approximate (multires transfer" in one.output
+    assert "full-resolution energy" in one.output and "at the start" in one.output
     two = runner.invoke(main, args + ["-o", str(tmp_path / "b.obj")])
     assert "coarse mesh from cache" in two.output
     assert (tmp_path / "a.obj").read_bytes() == (tmp_path / "b.obj").read_bytes()
@@ -277,3 +278,27 @@ def test_one_fine_factorization_serves_transfer_and_final_solve_for_every_pose(
     for shift in (0.5, 1.0, 1.5):
         d.solve(V[:6] + shift, max_iter=5)
     assert len(built) == factorizations
+
+
+def test_the_summary_counts_what_the_log_holds_and_reports_wall_seconds(tmp_path):
+    """Full-resolution and coarse iterations apart, each equal to the log's rows of its kind;
+    the seconds are the wall time of the solve (stages overlap and are not added)."""
+    import time
+
+    from srarap_cli.io.handles import load_handles
+    from srarap_cli.io.mesh import read_mesh
+    from srarap_cli.tasks.pipeline import deform_mesh
+
+    mesh = read_mesh(SPOT)
+    start = time.perf_counter()
+    _, result, _ = deform_mesh(mesh, load_handles(NOD, mesh.vertices), multires=2000)
+    wall = time.perf_counter() - start
+    steps = [row["step"] for row in result.log]
+    coarse_rows = sum(s.startswith("coarse-") and not s.endswith("start") for s in steps)
+    fine_rows = sum(not s.startswith("coarse-") and not s.endswith("start") for s in steps)
+    assert result.iterations == fine_rows and result.coarse_iterations == coarse_rows
+    assert result.seconds <= wall
+    r = CliRunner().invoke(main, ["deform", SPOT, NOD, "--multires", "2000", "-o",
+                                  str(tmp_path / "a.obj")])
+    assert (f"converged in {result.iterations} full-resolution iterations "
+            f"(+ {result.coarse_iterations} coarse)") in r.stderr

@@ -17,7 +17,15 @@ from ..runtime.errors import InputError, OutputError
 from ..runtime.limits import check_solve
 from ..solver.settings import resolve
 from ..tasks.animation import FRAME_FIELDS, Animator, FrameState, fingerprint
-from .common import cache_option, check_output_path, finite_option, guarded, refuse_overwrite
+from .common import (
+    cache_option,
+    check_output_path,
+    finite_option,
+    guarded,
+    refuse_overwrite,
+    report,
+    with_verbosity,
+)
 from .options import settings_options
 
 STATE_NAME = ".srarap-animate-state.npz"
@@ -46,10 +54,10 @@ MAX_FRAMES = 100_000
 @click.option("--resume", is_flag=True, help="Continue after the last complete frame.")
 @settings_options(exclude=("time_limit",))
 @cache_option
-@click.option("-q", "--quiet", is_flag=True, help="No progress, summary or warnings.")
+@with_verbosity
 @guarded
 def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, keep_unconverged,
-            log, resume, overrides, cache, quiet):
+            log, resume, overrides, cache, verbosity):
     """Deform MESH through the keyframes of HANDLES, writing one mesh per frame.
 
     Each frame starts from the frames before it and iterates to --tol (at most --max-iter
@@ -74,7 +82,7 @@ def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, ke
                          iters_per_frame, pattern)
     state = _resume_state(state_path, run_id) if resume else None
     animator = Animator(source, constraints, opts, cache=cache, name=mesh)
-    progress = _Progress(n_frames, enabled=not quiet and sys.stderr.isatty())
+    progress = _Progress(n_frames, enabled=verbosity != 0 and sys.stderr.isatty())
 
     def write_frame(f, positions, st):
         data, _ = format_mesh(source.with_vertices(positions), _suffix(pattern))
@@ -95,11 +103,9 @@ def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, ke
     stopped = animator.stopped_at
     if stopped is None and os.path.exists(state_path):
         os.unlink(state_path)
-    if not quiet:
-        for line in animator.last_result.report_lines() if animator.last_result else []:
-            click.echo(line, err=True)
-        click.echo(_summary(rows, state, n_frames, pattern, stopped, iters_per_frame, opts),
-                   err=True)
+    report(verbosity, warnings=animator.warnings,
+           details=animator.last_result.report_lines() if animator.last_result else [],
+           summary=_summary(rows, state, n_frames, pattern, stopped, iters_per_frame, opts))
     unconverged = sum(not r["converged"] for r in rows)
     if unconverged and not budget:
         raise SystemExit(exit_codes.NOT_CONVERGED)

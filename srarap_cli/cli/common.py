@@ -4,12 +4,14 @@ import math
 import os
 import sys
 import traceback
+from collections import Counter
 
 import click
 import numpy as np
 
 from ..io.handles import referenced_files
 from ..runtime import exit_codes, signals, streams
+from ..runtime.clock import elapsed
 from ..runtime.commit import COMMITTED
 from ..runtime.errors import InputError, NumericalError, OutputError, SingularSystemError
 from ..runtime.limits import is_out_of_memory, memory_note
@@ -129,6 +131,40 @@ def check_output_path(path, allowed, what):
         raise OutputError(f"{path}: folder {folder} is not writable")
     if os.path.isdir(path):
         raise OutputError(f"{path}: is a folder")
+
+
+def wall_seconds(result):
+    """The process's wall seconds for a summary (the solve's own when srarap runs inside
+    another program, whose clock did not start with srarap)."""
+    return elapsed() if signals.OWNED else result.seconds
+
+
+verbosity_options = [
+    click.option("-q", "--quiet", "verbosity", flag_value=0,
+                 help="Errors and warnings only (no summary line)."),
+    click.option("-v", "--verbose", "verbosity", flag_value=2,
+                 help="Also the stages and their timings."),
+]
+
+
+def with_verbosity(func):
+    """``-q`` / ``-v``: the command receives ``verbosity`` 0, 1 (default) or 2."""
+    for option in reversed(verbosity_options):
+        func = option(func)
+    return func
+
+
+def report(verbosity, *, warnings=(), details=(), summary=None):
+    """Print what a run has to say on stderr: each distinct warning once (with how many times
+    it came up), the detail lines with ``-v``, the summary line unless ``-q``."""
+    counts = Counter(warnings)
+    for text, n in counts.items():
+        click.echo(f"srarap: warning: {text}" + (f" ({n} times)" if n > 1 else ""), err=True)
+    if verbosity is not None and verbosity >= 2:
+        for line in details:
+            click.echo(line, err=True)
+    if summary is not None and (verbosity is None or verbosity >= 1):
+        click.echo(summary, err=True)
 
 
 def finite_option(_ctx, _param, value):

@@ -19,7 +19,16 @@ from ..solver.settings import complete, resolve
 from ..tasks.distortion import vertex_distortion
 from ..tasks.pipeline import deform_mesh
 from ..tasks.preview import preview_png
-from .common import cache_option, check_output_path, guarded, refuse_overwrite, write_stdout
+from .common import (
+    cache_option,
+    check_output_path,
+    guarded,
+    refuse_overwrite,
+    report,
+    wall_seconds,
+    with_verbosity,
+    write_stdout,
+)
 from .options import settings_options
 from .progress import SolveProgress
 
@@ -45,10 +54,10 @@ from .progress import SolveProgress
               help="Add a per-vertex 'distortion' property to PLY output.")
 @click.option("--keep-unconverged", is_flag=True,
               help="Write the mesh even when the solve did not converge (exit code still 3).")
-@click.option("-q", "--quiet", is_flag=True, help="No summary or warnings on stderr.")
+@with_verbosity
 @guarded
 def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, preview,
-           preview_up, write_distortion, keep_unconverged, quiet):
+           preview_up, write_distortion, keep_unconverged, verbosity):
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
@@ -72,7 +81,7 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
     check_solve(name, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
     opts = resolve(constraints.solver, overrides)
-    progress = SolveProgress(enabled=not quiet and sys.stderr.isatty())
+    progress = SolveProgress(enabled=verbosity != 0 and sys.stderr.isatty())
     try:
         deformed, result, notes = deform_mesh(source, constraints, callback=progress,
                                               cache=cache, name=name, settings=opts)
@@ -93,13 +102,9 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
     commit_files(files)
     if keep and out == "-":
         write_stdout(mesh_bytes)
-    if not quiet:
-        for note in notes + lost:
-            click.echo(f"srarap: warning: {note}", err=True)
-        for line in result.report_lines():
-            click.echo(line, err=True)
-        shown = "<stdout>" if out == "-" else out
-        click.echo(_summary(result, opts, shown if keep else None), err=True)
+    shown = "<stdout>" if out == "-" else out
+    report(verbosity, warnings=notes + lost, details=result.report_lines(),
+           summary=_summary(result, opts, shown if keep else None))
     if not done:
         raise SystemExit(exit_codes.NOT_CONVERGED)
 
@@ -130,18 +135,25 @@ def read_stdin_mesh(input_format):
 
 
 def _summary(result, opts, out):
-    last = result.log[-1]
-    if result.converged:
-        state = f"converged in {result.iterations} iterations"
-    elif complete(result, opts):
-        state = f"ran the {result.iterations} iterations asked (tol 0)"
-    else:
-        state = (f"NOT converged after {result.iterations} iterations "
-                 f"({_why(result.log, opts)}; {_advice(result, opts)})")
+    """The one summary line: what passed the stopping test (at full resolution), the
+    full-resolution and coarse iterations apart, the energy, the process's wall seconds."""
+    coarse = f" (+ {result.coarse_iterations} coarse)" if result.coarse_iterations else ""
     e = result.energies()
-    where = f"coarse energy {last['total']:.6g}; full " if result.coarse_log else ""
-    return (f"srarap deform: {state}; {where}energy {e['total']:.6g} (membrane "
-            f"{e['membrane']:.6g}, bending {e['bending']:.6g}); {result.seconds:.2f} s; "
+    energy = (f"energy {e['total']:.6g} (membrane {e['membrane']:.6g}, bending "
+              f"{e['bending']:.6g})")
+    if result.approximate:
+        state = (f"approximate (multires transfer: coarse solve "
+                 f"{'converged' if result.coarse_converged else 'NOT converged'} in "
+                 f"{result.coarse_iterations} iterations, none at full resolution)")
+        energy = f"full-resolution {energy}, {result.start_energy['total']:.6g} at the start"
+    elif result.converged:
+        state = f"converged in {result.iterations} full-resolution iterations{coarse}"
+    elif complete(result, opts):
+        state = f"ran the {result.iterations} iterations asked (tol 0){coarse}"
+    else:
+        state = (f"NOT converged after {result.iterations} full-resolution iterations{coarse} "
+                 f"({_why(result.log, opts)}; {_advice(result, opts)})")
+    return (f"srarap deform: {state}; {energy}; {wall_seconds(result):.2f} s; "
             + (f"wrote {out}" if out else "no mesh written (--keep-unconverged writes it)"))
 
 

@@ -39,12 +39,17 @@ class DeformResult:
     positions : (n, 3) float array
     rotors : (n, 4) float array, unit quaternions (w, x, y, z) of the vertex cells
     log : list of dict, one per iteration (0 is the start), keys ``solve_log.LOG_FIELDS``
-    converged : bool, the stopping test passed (see ``solve``'s ``tol``)
-    iterations : int, local/global iterations run
+    converged : bool, the stopping test passed at full resolution (see ``solve``'s ``tol``)
+    iterations : int, local/global iterations run at full resolution
+    coarse_iterations : int, iterations on coarse meshes (multiresolution; 0 here)
     coarse_log : bool (class attribute), the log follows another mesh than the result
+    approximate : bool (class attribute), the result is the paper's transfer of a coarse
+        solve, not iterated at full resolution
     """
 
     coarse_log = False
+    approximate = False
+    coarse_iterations = 0
     positions: np.ndarray
     rotors: np.ndarray
     log: list[dict] = field(default_factory=list)

@@ -214,8 +214,12 @@ def check_keywords(options, allowed_stages, where):
 
 
 def complete(result, opts):
-    """Whether a solve ended as asked: converged, or ``tol`` 0 (no stopping test: run exactly
-    ``max_iter`` iterations) with every iteration run."""
+    """Whether a solve ended as asked: converged; or ``tol`` 0 (no stopping test: run exactly
+    ``max_iter`` iterations) with every iteration run; or the approximate mode (transfer),
+    whose coarse solve converged (the full-resolution shape is never iterated there)."""
+    if result.approximate:
+        return bool(result.coarse_converged) or (
+            opts.tol == 0 and result.coarse_iterations >= opts.max_iter)
     return bool(result.converged) or (opts.tol == 0 and result.iterations >= opts.max_iter)
 
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..io.input_files import read_input_bytes
 from ..runtime.errors import InputError, excerpt
+from ..solver.mesh_checks import mesh_warnings
 from ..solver.quaternion import align_hemisphere, multiply, normalize
 from .pipeline import build_deformer, problem, scatter
 
@@ -77,6 +78,9 @@ class Animator:
         self.problem = problem(mesh, constraints, name)
         self.deformer = build_deformer(self.problem, opts, cache)
         self.solve_options = {"accel": opts.accel, "start": opts.start}
+        #: what the problem and the solver found worth a warning (e.g. mesh problems)
+        self.warnings = mesh_warnings(mesh.vertices, mesh.triangles()[0]) + list(
+            getattr(self.deformer, "warnings", []))
         self.last_result = None
 
     def run(self, frames, *, max_iter, tol, stop_unconverged=False, state=None,

@@ -41,21 +41,35 @@ class MultiresResult(DeformResult):
     coarse_log : bool, the log ends with coarse iterations (``transfer`` mode)
     full_energy : dict, ``membrane``, ``bending``, ``total`` of the returned full-resolution
         positions and rotors
-    stages : dict, seconds per stage (see STAGE_NAMES)
+    stages : dict, seconds per stage (see STAGE_NAMES); the simplification and the
+        full-resolution setup run side by side, so the stages add up to more than the wall time
     coarse : dict, ``vertices`` (coarse count), ``of`` (full count), ``cache_hit``
+    coarse_iterations : int, iterations of the coarse solve (and the coarser ones inside it)
+    coarse_converged : bool, the coarse solve passed its stopping test
+    start_energy : dict, transfer mode: the full-resolution energies of the rest shape with
+        the constrained vertices at their targets (what the approximation is judged against)
+    wall : float, wall seconds of the solve (setup excluded)
     """
 
     coarse_log: bool = True
     full_energy: dict = field(default_factory=dict)
     stages: dict = field(default_factory=dict)
     coarse: dict = field(default_factory=dict)
+    coarse_iterations: int = 0
+    coarse_converged: bool = False
+    start_energy: dict = field(default_factory=dict)
+    wall: float = 0.0
 
     def energies(self):
         return dict(self.full_energy)
 
     @property
+    def approximate(self):
+        return self.coarse_log
+
+    @property
     def seconds(self):
-        return sum(self.stages.values())
+        return self.wall
 
     def report_lines(self):
         """``srarap: multires: 5002 of 737986 vertices; simplify 1.20 s, ...``"""
@@ -63,6 +77,11 @@ class MultiresResult(DeformResult):
         cached = " (coarse mesh from cache)" if info["cache_hit"] else ""
         times = ", ".join(f"{STAGE_NAMES.get(k, k)} {v:.2f} s" for k, v in self.stages.items())
         return [f"srarap: multires: {info['vertices']} of {info['of']} vertices{cached}; {times}"]
+
+
+def _all_iterations(result):
+    """Every iteration ``result`` ran, on every level."""
+    return result.iterations + result.coarse_iterations
 
 
 class MultiresDeformer:
@@ -198,7 +217,7 @@ class MultiresDeformer:
         stages = dict(self.stages, coarse_solve=time.perf_counter() - begin)
         log = [dict(row, step="coarse-" + row["step"]) for row in coarse.log]
         if self.mode == "transfer":
-            return self._transfer(targets, coarse, log, stages)
+            return self._transfer(targets, coarse, log, stages, begin)
         mark = time.perf_counter()
         first = self._fine_start(targets, tol, coarse, start, initial)
         stages["fine_start"] = time.perf_counter() - mark
@@ -211,8 +230,11 @@ class MultiresDeformer:
         log += [dict(row, iteration=row["iteration"] + offset, seconds=row["seconds"] + elapsed)
                 for row in fine.log]
         return MultiresResult(fine.positions, fine.rotors, log, fine.converged,
-                              coarse.iterations + fine.iterations, coarse_log=False,
-                              full_energy=fine.energies(), stages=stages, coarse=self.info)
+                              fine.iterations, coarse_log=False,
+                              full_energy=fine.energies(), stages=stages, coarse=self.info,
+                              coarse_iterations=_all_iterations(coarse),
+                              coarse_converged=coarse.converged,
+                              wall=time.perf_counter() - begin)
 
     def coarse_correction(self, targets, tol=DEFAULTS["tol"]):
         """The :class:`~.correction.CoarseCorrection` of the full-resolution iterates for
@@ -254,7 +276,7 @@ class MultiresDeformer:
         best = min(candidates, key=lambda state: state.total)
         return best.positions, best.rotors
 
-    def _transfer(self, targets, coarse, log, stages):
+    def _transfer(self, targets, coarse, log, stages, begin):
         """The paper's result: coarse rotors spread harmonically, one Poisson solve."""
         mark = time.perf_counter()
         R = spread_rotors(self.solver, self._known_rotors(targets, coarse.rotors))
@@ -266,8 +288,13 @@ class MultiresDeformer:
         energy = self.fine.energy(P, R)
         if not (np.isfinite(P).all() and np.isfinite(energy["total"])):
             raise NumericalError("the full-resolution solve produced non-finite values")
-        return MultiresResult(P, R, log, coarse.converged, coarse.iterations,
-                              full_energy=energy, stages=stages, coarse=self.info)
+        rest = self.V.copy()
+        rest[self.constrained] = targets
+        start = self.fine.energy(rest, np.tile(IDENTITY, (len(self.V), 1)))
+        return MultiresResult(P, R, log, False, 0, full_energy=energy, stages=stages,
+                              coarse=self.info, coarse_iterations=_all_iterations(coarse),
+                              coarse_converged=coarse.converged, start_energy=start,
+                              wall=time.perf_counter() - begin)
 
     def _known_rotors(self, targets, coarse_rotors):
         out = np.tile(IDENTITY, (self._known.size, 1))
