@@ -13,7 +13,7 @@ do not load the numerical stack.
 import importlib
 
 _WHERE = {"Constraints": "io.handles", "DeformResult": "solver.deformer",
-          "Deformer": "solver.deformer", "Mesh": "io.mesh", "deform": "solver.oneshot",
+          "Deformer": "solver.deformer", "Mesh": "io.mesh", "deform": "tasks.api",
           "deform_mesh": "tasks.pipeline", "load_handles": "io.handles", "read_mesh": "io.mesh",
           "write_mesh": "io.mesh"}
 

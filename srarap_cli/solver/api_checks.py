@@ -60,3 +60,49 @@ def _floats(values, name):
         return np.asarray(values, dtype=float)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be an array of numbers") from None
+
+
+def mesh_like(mesh, name="mesh"):
+    """``(V, F)`` arrays of whatever the ecosystem calls a mesh, without importing its package.
+
+    Accepts a ``(V, F)`` pair, srarap's :class:`~srarap_cli.io.mesh.Mesh`, a
+    ``meshio.Mesh`` (``points`` and triangle or quad ``cells``; quads split in two), and
+    anything with ``vertices`` and ``faces`` arrays (``trimesh.Trimesh``, ``open3d``'s
+    ``TriangleMesh`` after ``np.asarray``). Raises TypeError naming ``name`` otherwise.
+
+    Examples
+    --------
+    >>> V, F = mesh_like(([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]))
+    >>> V.shape, F.tolist()
+    ((3, 3), [[0, 1, 2]])
+    >>> mesh_like("bunny.obj")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    TypeError: mesh must be a (V, F) pair, ... got str (read a file with srarap_cli.read_mesh)
+    """
+    if isinstance(mesh, (tuple, list)) and len(mesh) == 2:
+        return mesh_arrays(*mesh)
+    if hasattr(mesh, "face_sizes") and hasattr(mesh, "triangles"):  # srarap's own Mesh
+        return mesh_arrays(mesh.vertices, mesh.triangles()[0])
+    if hasattr(mesh, "points") and hasattr(mesh, "cells"):  # meshio.Mesh
+        return mesh_arrays(mesh.points[:, :3] if np.ndim(mesh.points) == 2 else mesh.points,
+                           _meshio_triangles(mesh.cells, name))
+    if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
+        return mesh_arrays(np.asarray(mesh.vertices), np.asarray(mesh.faces))
+    hint = " (read a file with srarap_cli.read_mesh)" if isinstance(mesh, (str, bytes)) or \
+        hasattr(mesh, "__fspath__") else ""
+    raise TypeError(f"{name} must be a (V, F) pair, a trimesh.Trimesh, a meshio.Mesh or an "
+                    f"object with vertices and faces arrays, got {type(mesh).__name__}{hint}")
+
+
+def _meshio_triangles(cells, name):
+    parts = []
+    for block in cells:
+        data = np.asarray(block.data)
+        if block.type == "triangle":
+            parts.append(data)
+        elif block.type == "quad":
+            parts += [data[:, [0, 1, 2]], data[:, [0, 2, 3]]]
+    if not parts:
+        raise ValueError(f"{name}: the meshio.Mesh has no triangle or quad cells")
+    return np.vstack(parts)

@@ -55,6 +55,30 @@ class DeformResult:
     log: list[dict] = field(default_factory=list)
     converged: bool = False
     iterations: int = 0
+    #: (f, 3) triangles of the mesh, when the result came from ``srarap_cli.deform`` on a mesh
+    faces: np.ndarray | None = None
+    #: what the input or the solve found worth a warning (mesh problems, weights)
+    warnings: list[str] = field(default_factory=list)
+
+    def to_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(V, F)``: the deformed positions (n, 3) and the triangles (f, 3)."""
+        if self.faces is None:
+            raise ValueError("this result carries no faces: pair positions with your F")
+        return self.positions, self.faces
+
+    def to_trimesh(self):
+        """A ``trimesh.Trimesh`` of the deformed shape (needs trimesh installed)."""
+        import trimesh
+
+        V, F = self.to_arrays()
+        return trimesh.Trimesh(vertices=V, faces=F, process=False)
+
+    def to_meshio(self):
+        """A ``meshio.Mesh`` of the deformed shape."""
+        import meshio
+
+        V, F = self.to_arrays()
+        return meshio.Mesh(V, [("triangle", F)])
 
     def energies(self) -> dict[str, float]:
         """``membrane``, ``bending`` and ``total`` energy of the returned shape."""

@@ -74,6 +74,8 @@ def problem(mesh, constraints, name="mesh"):
 
 
 def _labels(constraints, full_ids):
+    if not constraints.groups:  # (ids, targets) from the API: the solver finds the patches
+        return None
     labels = np.full(len(full_ids), len(constraints.groups), dtype=np.int64)
     for g, members in reversed(list(enumerate(constraints.groups.values()))):
         labels[np.isin(full_ids, members)] = g

@@ -11,6 +11,8 @@ import numpy as np
 
 from ...runtime.errors import InputError
 from ...runtime.limits import MAX_COORDINATE
+from ...solver.api_checks import targets as checked_targets
+from ...solver.api_checks import vertex_ids
 from ...solver.settings import parse_mapping
 from ..documents import load_document
 from .fields import Context
@@ -57,6 +59,37 @@ class Constraints:
         for slots, rest, track in self.tracks:
             out[slots] = track.apply(rest, frame)
         return out
+
+
+def as_constraints(handles, V: np.ndarray) -> "Constraints":
+    """Constraints from what a Python caller has: a handle file's path, a dict in the handle
+    file's schema, an ``(ids, targets)`` pair, or Constraints. Raises TypeError naming
+    ``handles`` for anything else, ValueError for a wrong pair.
+
+    Examples
+    --------
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> c = as_constraints(([2, 0], [[0, 2, 0], [0, 0, 0]]), V)
+    >>> c.ids.tolist(), c.targets.tolist()
+    ([0, 2], [[0.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
+    """
+    if isinstance(handles, Constraints):
+        return handles
+    if isinstance(handles, (str, os.PathLike)):
+        return load_handles(handles, V)
+    if isinstance(handles, dict):
+        try:
+            return parse_handles(handles, V)
+        except InputError as exc:
+            raise ValueError(str(exc).replace("<handles>: ", "handles: ", 1)) from None
+    if isinstance(handles, (tuple, list)) and len(handles) == 2:
+        ids = vertex_ids(handles[0], len(V), "handles ids")
+        tgt = checked_targets(handles[1], len(ids))
+        order = np.argsort(ids, kind="stable")
+        # no groups: the solver groups the ids by the connected patches they form
+        return Constraints(ids=ids[order], targets=tgt[order])
+    raise TypeError("handles must be a handle file's path, a dict in the handle-file schema, "
+                    f"an (ids, targets) pair or Constraints, got {type(handles).__name__}")
 
 
 def load_handles(path: str | os.PathLike, V: np.ndarray,

@@ -145,10 +145,24 @@ def _vertex_normals(mesh):
 def write_mesh(path: str | os.PathLike, mesh: Mesh) -> list[str]:
     """Write ``mesh`` to ``path`` (format from the extension) atomically.
 
+    Parameters
+    ----------
+    path : str or PathLike, ``.obj``, ``.off`` or ``.ply``
+    mesh : Mesh, or anything :func:`srarap_cli.solver.api_checks.mesh_like` takes (a
+        ``(V, F)`` pair, a trimesh or meshio mesh)
+
     Returns
     -------
     list of str : warnings about data the format cannot hold
     """
+    if not isinstance(path, (str, os.PathLike)):
+        swapped = " (the arguments are (path, mesh))" if isinstance(mesh, (str, os.PathLike)) \
+            else ""
+        raise TypeError(f"path must be a file path, got {type(path).__name__}{swapped}")
+    if not isinstance(mesh, Mesh):
+        from ...solver.api_checks import mesh_like
+
+        mesh = Mesh.from_arrays(*mesh_like(mesh))
     suffix = _suffix(path)
     if suffix not in WRITE_FORMATS:
         raise OutputError(f"{path}: cannot write {suffix or 'files without extension'}; "

@@ -32,6 +32,32 @@ class Mesh:
     vertex_data: dict = field(default_factory=dict)
     statements: list = field(default_factory=list)
 
+    @classmethod
+    def from_arrays(cls, V, F) -> "Mesh":
+        """A mesh of positions ``V`` (n, 3) and faces ``F``: an (f, k) int array of k-gons,
+        or a list of vertex-id sequences of any sizes.
+
+        Examples
+        --------
+        >>> m = Mesh.from_arrays([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]])
+        >>> m.face_sizes.tolist(), m.triangles()[0].tolist()
+        ([4], [[0, 1, 2], [0, 2, 3]])
+        """
+        V = np.asarray(V, dtype=float)
+        if V.ndim != 2 or V.shape[1] != 3:
+            raise ValueError(f"V must be an (n, 3) array of positions, got shape {V.shape}")
+        faces = [np.asarray(f).ravel() for f in F] if not isinstance(F, np.ndarray) \
+            else list(F.reshape(len(F), -1))
+        if not faces or any(len(f) < 3 for f in faces):
+            raise ValueError("F must list faces of 3 or more vertex ids")
+        corners = np.concatenate(faces)
+        if corners.dtype.kind not in "iu":
+            raise ValueError(f"F must hold integer vertex ids, got dtype {corners.dtype}")
+        if corners.min() < 0 or corners.max() >= len(V):
+            raise ValueError(f"F: vertex id out of range for V of {len(V)} rows")
+        return cls(vertices=V, face_sizes=np.array([len(f) for f in faces], dtype=np.int64),
+                   face_vertices=corners.astype(np.int64))
+
     @property
     def face_offsets(self):
         """(k + 1,) cumulative corner offsets: polygon f is ``face_vertices[o[f]:o[f+1]]``."""

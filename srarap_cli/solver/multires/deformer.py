@@ -6,13 +6,14 @@ from dataclasses import dataclass, field
 from functools import partial
 
 import numpy as np
+import scipy.sparse as sp
 
 from ...runtime.errors import NumericalError
 from ...runtime.threads import background, single_threaded
 from .. import api_checks
 from ..deformer import ACCEL_DRIVERS, Deformer, DeformResult
 from ..drivers.anderson import anderson_iteration
-from ..group_rotations import group_rotors
+from ..group_rotations import connected_groups, group_rotors
 from ..quaternion import IDENTITY
 from ..settings import DEFAULTS
 from ..starts import STARTS
@@ -79,6 +80,13 @@ class MultiresResult(DeformResult):
         return [f"srarap: multires: {info['vertices']} of {info['of']} vertices{cached}; {times}"]
 
 
+def _adjacency(F, n):
+    """(n, n) sparse matrix, nonzero where two vertices share an edge of ``F``."""
+    i = F[:, [0, 1, 2, 1, 2, 0]].ravel()
+    j = F[:, [1, 2, 0, 0, 1, 2]].ravel()
+    return sp.csr_matrix((np.ones(i.size), (i, j)), shape=(n, n))
+
+
 def _all_iterations(result):
     """Every iteration ``result`` ran, on every level."""
     return result.iterations + result.coarse_iterations
@@ -103,7 +111,8 @@ class MultiresDeformer:
     ----------
     V : (n, 3) float array; F : (f, 3) int array
     constrained : (k,) int array
-    labels : (k,) int array, handle group of each constrained vertex (default: one group)
+    labels : (k,) int array, handle group of each constrained vertex (default: the connected
+        patches they form, as :class:`Deformer`)
     size : int, wanted coarse vertex count
     cache : str, optional folder for coarse meshes
     mode : {"refine", "transfer"}, what follows the coarse solve: full-resolution iterations
@@ -136,8 +145,8 @@ class MultiresDeformer:
         start = time.perf_counter()
         self.V, self.F = api_checks.mesh_arrays(V, F)
         self.constrained = api_checks.vertex_ids(constrained, len(self.V))
-        k = self.constrained.size
-        self.labels = np.zeros(k, np.int64) if labels is None else np.asarray(labels, np.int64)
+        self.labels = (connected_groups(_adjacency(self.F, len(self.V)), self.constrained)
+                       if labels is None else np.asarray(labels, np.int64))
         self.n_groups = int(self.labels.max(initial=-1)) + 1
         groups = [self.constrained[self.labels == g] for g in range(self.n_groups)]
         # the full-resolution setup needs no coarse mesh: it runs beside the simplification

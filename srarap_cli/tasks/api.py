@@ -1,0 +1,61 @@
+"""The one-shot function of the Python API: any mesh, any handles, one deformation."""
+from dataclasses import replace
+from typing import Any
+
+from ..io.handles import as_constraints
+from ..io.mesh.mesh import Mesh
+from ..solver.api_checks import mesh_like
+from ..solver.deformer import DeformResult
+from ..solver.oneshot import deform as deform_arrays
+from ..solver.settings import check_keywords
+from .pipeline import deform_mesh
+
+
+def deform(mesh: Any, handles: Any, *arrays: Any, callback=None, cache: str | None = None,
+           initial=None, **settings: Any) -> DeformResult:
+    """Deform a mesh by its handles, in one call.
+
+    Parameters
+    ----------
+    mesh : a ``(V, F)`` pair, a :class:`~srarap_cli.io.mesh.Mesh` (from
+        :func:`~srarap_cli.io.mesh.read_mesh` or ``Mesh.from_arrays``), a ``trimesh.Trimesh``,
+        a ``meshio.Mesh``, or anything with ``vertices`` and ``faces`` arrays
+    handles : a handle file's path, a dict in the handle-file schema (``{"groups": ...}``),
+        or an ``(ids, targets)`` pair: (k,) vertex ids and their (k, 3) target positions
+    callback : callable(dict), optional, receives each log row
+    cache : str, optional, folder for multiresolution coarse meshes
+    **settings : solver settings (``alpha``, ``tol``, ``max_iter``, ``multires``, ...); a
+        handle file's ``solver`` section applies under them
+
+    Returns
+    -------
+    DeformResult, with ``faces`` set: ``result.to_arrays()``, ``result.to_trimesh()``,
+    ``result.to_meshio()``; ``result.warnings`` lists what the input deserved a warning for
+
+    The array form ``deform(V, F, constrained, targets, initial=..., ...)`` of
+    :func:`srarap_cli.solver.oneshot.deform` is accepted too (a warm start needs it, or a
+    :class:`~srarap_cli.solver.deformer.Deformer`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    >>> r = deform((V, [[0, 1, 2], [1, 3, 2]]), ([0, 1, 2, 3], V + 1.0))
+    >>> r.converged, r.to_arrays()[1].shape
+    (True, (2, 3))
+    """
+    if len(arrays) == 2:
+        return deform_arrays(mesh, handles, *arrays, initial=initial, callback=callback,
+                             cache=cache, **settings)
+    if arrays:
+        raise TypeError("deform() takes (mesh, handles) or (V, F, constrained, targets), "
+                        f"got {2 + len(arrays)} positional arguments")
+    if initial is not None:
+        raise TypeError("deform(mesh, handles) starts cold; for a warm start use "
+                        "deform(V, F, constrained, targets, initial=...) or a Deformer")
+    check_keywords(settings, ("setup", "build", "solve"), "deform")
+    source = mesh if isinstance(mesh, Mesh) else Mesh.from_arrays(*mesh_like(mesh))
+    constraints = as_constraints(handles, source.vertices)
+    _, result, notes = deform_mesh(source, constraints, callback=callback, cache=cache,
+                                   **settings)
+    return replace(result, faces=source.triangles()[0], warnings=list(notes))
