@@ -24,14 +24,28 @@ def _indices(ctx, spec, V, base):
     return idx
 
 
-def _sphere(ctx, spec, V, base):
+def _shapes(select_one):
+    """A selector of one shape that also takes a list of them (the union of their vertices)."""
+    def select_any(ctx, spec, V, base):
+        if isinstance(spec, list):
+            if not spec:
+                raise ctx.error(f"{select_one.__name__[1:]}: an empty list selects nothing")
+            return np.unique(np.concatenate([
+                select_one(ctx.at(f"{ctx.where}, {select_one.__name__[1:]} {k}".lstrip(", ")),
+                           one, V)
+                for k, one in enumerate(spec)]))
+        return select_one(ctx, spec, V)
+    return select_any
+
+
+def _sphere(ctx, spec, V):
     spec = ctx.record(spec, "sphere", ("center", "radius"))
     center = ctx.vector(spec["center"], "center", 3)
     radius = ctx.number(spec["radius"], "radius", 0, strict=True)
     return np.flatnonzero(np.sum((V - center) ** 2, axis=1) <= radius * radius)
 
 
-def _box(ctx, spec, V, base):
+def _box(ctx, spec, V):
     spec = ctx.record(spec, "box", ("min", "max"))
     lo, hi = ctx.vector(spec["min"], "min", 3), ctx.vector(spec["max"], "max", 3)
     if (lo > hi).any():
@@ -61,7 +75,8 @@ def _sel(ctx, spec, V, base):
                           == SEL_STATUS[spec["status"]])
 
 
-_SELECTORS = {"indices": _indices, "sphere": _sphere, "box": _box, "dmat": _dmat, "sel": _sel}
+_SELECTORS = {"indices": _indices, "sphere": _shapes(_sphere), "box": _shapes(_box),
+              "dmat": _dmat, "sel": _sel}
 
 
 def select(ctx, spec, V, base):

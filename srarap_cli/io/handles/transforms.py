@@ -10,22 +10,40 @@ from .formats import read_def
 ACTION_KEYS = ("fixed", "translate", "rotate", "pivot", "matrix")
 
 
+#: rotation angle keys and the factor to degrees: ``angle`` is degrees (kept for files
+#: written before the explicit keys)
+ANGLE_KEYS = {"angle_deg": 1.0, "angle_rad": 180.0 / np.pi, "angle": 1.0}
+#: quaternion keys and the order of their components; ``quaternion`` is w, x, y, z (scipy's
+#: ``Rotation.from_quat`` takes x, y, z, w: say ``quaternion_xyzw`` for that order)
+QUATERNION_KEYS = {"quaternion_wxyz": [0, 1, 2, 3], "quaternion_xyzw": [3, 0, 1, 2],
+                   "quaternion": [0, 1, 2, 3]}
+
+
 def rotation_matrix(ctx, spec):
-    """3x3 matrix of a ``rotate`` entry (axis and angle in degrees, or a quaternion)."""
-    spec = ctx.mapping(spec, "rotate", ("axis", "angle", "quaternion"))
-    if "quaternion" in spec:
-        if "axis" in spec or "angle" in spec:
-            raise ctx.error("rotate takes either 'quaternion' or 'axis' and 'angle'")
-        q = ctx.vector(spec["quaternion"], "quaternion [w, x, y, z]", 4)
+    """3x3 matrix of a ``rotate`` entry: ``axis`` with ``angle_deg``, ``angle_rad`` or
+    ``angle`` (degrees), or one of ``quaternion_wxyz``, ``quaternion_xyzw``, ``quaternion``
+    (w, x, y, z)."""
+    spec = ctx.mapping(spec, "rotate", ("axis", *ANGLE_KEYS, *QUATERNION_KEYS))
+    angles = [k for k in ANGLE_KEYS if k in spec]
+    quats = [k for k in QUATERNION_KEYS if k in spec]
+    if len(quats) + (len(angles) > 0 or "axis" in spec) != 1 or len(quats) > 1:
+        raise ctx.error("rotate takes 'axis' with one angle (angle_deg, angle_rad, or angle in "
+                        "degrees), or one quaternion (quaternion_wxyz, quaternion_xyzw, or "
+                        "quaternion as w, x, y, z)")
+    if quats:
+        key = quats[0]
+        order = "x, y, z, w" if key == "quaternion_xyzw" else "w, x, y, z"
+        q = ctx.vector(spec[key], f"{key} [{order}]", 4)[QUATERNION_KEYS[key]]
         if np.linalg.norm(q) < 1e-12:
-            raise ctx.error("quaternion must not be zero")
+            raise ctx.error(f"{key} must not be zero")
         return to_matrix(q / np.linalg.norm(q))
-    if "axis" not in spec or "angle" not in spec:
-        raise ctx.error("rotate needs 'axis' and 'angle' (degrees), or 'quaternion'")
+    if "axis" not in spec or len(angles) != 1:
+        raise ctx.error("rotate needs 'axis' and one of angle_deg, angle_rad or angle (degrees)")
     axis = ctx.vector(spec["axis"], "axis", 3)
     if np.linalg.norm(axis) < 1e-12:
         raise ctx.error("axis must not be zero")
-    return to_matrix(from_axis_angle(axis, ctx.number(spec["angle"], "angle")))
+    key = angles[0]
+    return to_matrix(from_axis_angle(axis, ctx.number(spec[key], key) * ANGLE_KEYS[key]))
 
 
 def _matrix(ctx, value, base):
