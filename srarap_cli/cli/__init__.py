@@ -23,6 +23,8 @@ COMMANDS = {
                                       "Hausdorff distance of their surfaces."),
     "batch": ("batch", "batch", "Run every job of MANIFEST (YAML/JSON); a failing job never "
                                 "stops the others."),
+    "info": ("info", "info", "Describe MESH and what HANDLES selects and does, without "
+                             "solving."),
     "render": ("render", "render", "Render MESH to a PNG, headless."),
     "plot": ("render", "plot", "Plot total energy against iteration and time for one or more "
                                "deform logs (CSV/JSONL)."),

@@ -1,0 +1,56 @@
+"""``srarap info``: what a mesh is and what a handle file does to it, without solving."""
+import json
+
+import click
+
+from ..io.handles import load_handles
+from ..io.mesh import read_mesh
+from ..tasks.info import handles_info, mesh_info
+from .common import guarded
+from .deform import read_stdin_mesh
+
+
+@click.command("info")
+@click.argument("mesh")
+@click.argument("handles", required=False)
+@click.option("--input-format", type=click.Choice(["obj", "off", "ply", "stl"]),
+              help="Format of MESH when it is '-' (standard input).")
+@click.option("--json", "as_json", is_flag=True, help="One JSON document on standard output.")
+@guarded
+def info(mesh, handles, input_format, as_json):
+    """Describe MESH (counts, extent per axis, problems) and, with HANDLES, what each group
+    selects and does: a dry run of the checks deform makes (exit 4 when the file is invalid).
+    """
+    source = read_stdin_mesh(input_format) if mesh == "-" else read_mesh(mesh)
+    name = "<stdin>" if mesh == "-" else mesh
+    out = {"mesh": name, **mesh_info(source)}
+    if handles is not None:
+        out["handles"] = handles
+        out.update(handles_info(source, load_handles(handles, source.vertices), name))
+    if as_json:
+        click.echo(json.dumps(out, indent=2))
+    else:
+        click.echo(_text(out))
+
+
+def _text(d):
+    lines = [f"{d['mesh']}: {d['vertices']} vertices, {d['faces']} faces "
+             f"({d['triangles']} triangles), {d['components']} connected part"
+             f"{'s' if d['components'] != 1 else ''}, {d['boundary_loops']} boundary loop"
+             f"{'s' if d['boundary_loops'] != 1 else ''}"]
+    for k, axis in enumerate("xyz"):
+        lines.append(f"  {axis}: {d['bbox_min'][k]:.6g} .. {d['bbox_max'][k]:.6g} "
+                     f"(extent {d['extent'][k]:.6g})")
+    lines.append(f"  diagonal {d['diagonal']:.6g}; up axis, a guess: {d['up_guess']}")
+    lines += [f"  problem: {p}" for p in d["problems"]] or ["  no problems found"]
+    if "groups" in d:
+        lines.append(f"{d['handles']}: {len(d['groups'])} groups, {d['constrained']} "
+                     f"constrained vertices, {d['free']} free"
+                     + (f" (region of interest: {d['region']} vertices)" if d["region"]
+                        is not None else ""))
+        for g in d["groups"]:
+            lines.append(f"  {g['name']}: {g['vertices']} vertices: {g['action']}")
+        for o in d["overlaps"]:
+            lines.append(f"  overlap: {o['vertices']} vertices in both "
+                         f"{o['groups'][0]!r} and {o['groups'][1]!r}")
+    return "\n".join(lines)

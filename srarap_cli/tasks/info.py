@@ -1,0 +1,138 @@
+"""What a mesh is, and what a handle file does to it, before any solve (``srarap info``)."""
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse import csgraph
+
+from ..io.handles import Constraints
+from ..io.mesh import Mesh
+from ..solver.group_rotations import group_rotors
+from ..solver.mesh_checks import edge_counts, mesh_warnings
+from ..solver.quaternion import IDENTITY, to_matrix
+from .pipeline import problem
+
+AXES = "xyz"
+
+
+def mesh_info(mesh: Mesh) -> dict:
+    """Counts, extent and problems of ``mesh``.
+
+    Returns
+    -------
+    dict with ``vertices``, ``faces`` (polygons), ``triangles``, ``components`` (connected
+    parts of the faces), ``boundary_loops``, ``bbox_min`` / ``bbox_max`` / ``extent`` (per
+    axis), ``diagonal``, ``up_guess`` and ``problems`` (list of str)
+    """
+    V = mesh.vertices
+    F = mesh.triangles()[0]
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    return {"vertices": len(V), "faces": int(mesh.face_sizes.size), "triangles": len(F),
+            "components": _components(F, len(V)), "boundary_loops": _boundary_loops(F),
+            "bbox_min": lo.tolist(), "bbox_max": hi.tolist(), "extent": (hi - lo).tolist(),
+            "diagonal": float(np.linalg.norm(hi - lo)), "up_guess": _up_guess(V, F),
+            "problems": mesh_warnings(V, F)}
+
+
+def handles_info(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> dict:
+    """Per group of ``constraints``: vertices selected, the action in words, overlaps; the
+    region's size and how many vertices are free. Runs the checks a solve would (a dry run).
+    """
+    p = problem(mesh, constraints, name)  # the same validation as deform
+    slots = {g: np.searchsorted(constraints.ids, ids) for g, ids in constraints.groups.items()}
+    groups = []
+    for g, ids in constraints.groups.items():
+        track = next((t for s, _, t in constraints.tracks
+                      if np.array_equal(constraints.ids[s], ids)), None)
+        action = (f"keyframed ({len(track.frames)} keys, last at frame {track.frames[-1]:g})"
+                  if track is not None else
+                  describe_motion(mesh.vertices[ids], constraints.targets[slots[g]]))
+        groups.append({"name": g, "vertices": int(len(ids)), "action": action})
+    names = list(constraints.groups)
+    overlaps = [{"groups": [a, b], "vertices": int(np.intersect1d(
+        constraints.groups[a], constraints.groups[b]).size)}
+        for i, a in enumerate(names) for b in names[i + 1:]]
+    n = len(mesh.vertices)
+    region = None if constraints.region is None else int(np.unique(constraints.region).size)
+    return {"groups": groups, "overlaps": [o for o in overlaps if o["vertices"]],
+            "constrained": int(constraints.ids.size), "region": region,
+            "free": int(len(p.V) - p.ids.size), "of": n}
+
+
+def describe_motion(rest, targets):
+    """The rigid motion that best takes ``rest`` (k, 3) to ``targets``, in words.
+
+    Examples
+    --------
+    >>> rest = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> describe_motion(rest, rest + [3, 0, -1.5])
+    'translate (3, 0, -1.5)'
+    >>> turned = rest @ np.array([[0., 0, 1], [0, 1, 0], [-1, 0, 0]]).T
+    >>> describe_motion(rest, turned)
+    'rotate 90 degrees about +y through (0.333333, 0.333333, 0), then translate (-0.333333, 0, -0.333333)'
+    """
+    if np.allclose(rest, targets, rtol=0, atol=1e-12 * max(np.abs(rest).max(), 1.0)):
+        return "fixed"
+    labels = np.zeros(len(rest), np.int64)
+    q, determined = group_rotors(rest, targets, labels, 1)
+    q = q[0] if determined.all() else IDENTITY
+    q = q if q[0] >= 0 else -q
+    angle = float(np.degrees(2 * np.arctan2(np.linalg.norm(q[1:]), q[0])))
+    c, d = rest.mean(axis=0), targets.mean(axis=0) - rest.mean(axis=0)
+    words = []
+    if angle > 1e-9:
+        axis = q[1:] / np.linalg.norm(q[1:])
+        words.append(f"rotate {angle:.6g} degrees about {_direction(axis)} through {_vec(c)}")
+    if np.linalg.norm(d) > 1e-12 * max(np.abs(rest).max(), 1.0):
+        words.append(f"translate {_vec(d)}")
+    text = ", then ".join(words) or "fixed"
+    if determined.all():
+        R = to_matrix(q)
+        residual = np.abs((rest - c) @ R.T + c + d - targets).max()
+        if residual > 1e-9 * max(np.ptp(rest, axis=0).max(), 1e-300):
+            text += f" (not rigid: up to {residual:.3g} off that motion)"
+    return text
+
+
+def _direction(axis):
+    k = int(np.argmax(np.abs(axis)))
+    if np.abs(axis[k]) > 1 - 1e-9:
+        return ("+" if axis[k] > 0 else "-") + AXES[k]
+    return _vec(axis)
+
+
+def _vec(v):
+    return "(" + ", ".join(f"{x + 0.0:.6g}" for x in v) + ")"
+
+
+def _components(F, n):
+    A = sp.csr_matrix((np.ones(3 * len(F)), (F.ravel(), np.roll(F, 1, axis=1).ravel())),
+                      shape=(n, n))
+    used = np.zeros(n, bool)
+    used[F.ravel()] = True
+    labels = csgraph.connected_components(A, directed=False)[1]
+    return int(np.unique(labels[used]).size)
+
+
+def _boundary_loops(F):
+    edges, counts = edge_counts(F)
+    boundary = edges[counts == 1]
+    if not len(boundary):
+        return 0
+    ids, inverse = np.unique(boundary, return_inverse=True)
+    inverse = inverse.reshape(-1, 2)
+    A = sp.csr_matrix((np.ones(len(inverse)), (inverse[:, 0], inverse[:, 1])),
+                      shape=(len(ids),) * 2)
+    return int(csgraph.connected_components(A, directed=False)[0])
+
+
+def _up_guess(V, F):
+    """y or z, whichever the mesh more likely stands on: the one whose lowest slab carries
+    more downward-facing area (a base, feet, a bottom); y on a tie, as most OBJ and PLY
+    files are y-up. A guess, and said to be one: a lying cylinder fools it."""
+    normals = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]) / 2
+    centers = V[F].mean(axis=1)
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    scores = {}
+    for k in (1, 2):
+        low = centers[:, k] <= lo[k] + 0.05 * (hi[k] - lo[k])
+        scores[k] = -normals[low, k].sum()
+    return "+" + AXES[max((1, 2), key=lambda k: (scores[k], k == 1))]

@@ -1,0 +1,117 @@
+"""``srarap info``: counts and extent that can be checked by hand, actions described as the
+motions they are, and a dry run that refuses exactly what deform refuses."""
+import glob
+import json
+import os
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from helpers import SHARED, needs_shared, tube_mesh
+
+from srarap_cli.cli import main
+from srarap_cli.io.handles import parse_handles
+from srarap_cli.io.mesh import write_mesh
+from srarap_cli.io.mesh.mesh import Mesh
+from srarap_cli.tasks.info import describe_motion, mesh_info
+
+
+def test_counts_extent_parts_and_loops_of_known_meshes():
+    bar = tube_mesh(length=6.0, rings=5, segments=8)
+    d = mesh_info(bar)
+    assert d["vertices"] == len(bar.vertices) and d["faces"] == bar.face_sizes.size
+    assert d["components"] == 1 and d["boundary_loops"] == 0
+    np.testing.assert_allclose(d["extent"], [2, 2, 6], atol=1e-12)  # 8 segments: at 0, 90 deg
+    # an open tube (caps dropped) twice, apart: two parts, four boundary loops
+    quads = bar.face_vertices[:bar.face_sizes.tolist().index(3) * 4].reshape(-1, 4)
+    V = np.vstack([bar.vertices, bar.vertices + [10, 0, 0]])
+    open_pair = Mesh.from_arrays(V, np.vstack([quads, quads + len(bar.vertices)]))
+    d = mesh_info(open_pair)
+    assert d["components"] == 2 and d["boundary_loops"] == 4
+
+
+@pytest.mark.parametrize("action, words", [
+    ({"fixed": True}, "fixed"),
+    ({"translate": [3, 0, -1.5]}, "translate (3, 0, -1.5)"),
+    ({"rotate": {"axis": [0, 1, 0], "angle_deg": 60}, "pivot": [0, 0, 10]},
+     "rotate 60 degrees about +y through"),
+])
+def test_actions_are_described_as_the_motions_they_are(action, words):
+    bar = tube_mesh(length=10.0, rings=5, segments=8)
+    doc = {"groups": {"g": {"box": {"min": [-2, -2, 9.9], "max": [2, 2, 10.1]}, **action}}}
+    c = parse_handles(doc, bar.vertices)
+    text = describe_motion(bar.vertices[c.ids], c.targets)
+    assert text.startswith(words) and "not rigid" not in text
+
+
+def test_a_rigid_description_reproduces_the_targets():
+    rng = np.random.default_rng(3)
+    rest = rng.normal(size=(20, 3))
+    c = parse_handles({"groups": {"g": {"indices": list(range(20)),
+                                        "rotate": {"axis": [1, 2, 3], "angle_deg": 37},
+                                        "translate": [0.5, -2, 1]}}}, rest)
+    text = describe_motion(rest, c.targets)
+    assert "rotate 37 degrees" in text and "then translate" in text and "not rigid" not in text
+    bent = c.targets + rng.normal(scale=0.1, size=c.targets.shape)
+    assert "not rigid" in describe_motion(rest, bent)
+
+
+BAD = [
+    "groups: {}\n",
+    "groups: {g: {indices: [999999], fixed: true}}\n",
+    "groups: {g: {box: {min: [1, 1, 1], max: [0, 0, 0]}, fixed: true}}\n",
+    "groups: {g: {indices: [0], rotate: {axis: [0, 0, 1]}}}\n",
+    "groups:\n  a: {indices: [0], fixed: true}\n  b: {indices: [0], translate: [1, 0, 0]}\n",
+    "solver: {tol: -1}\ngroups: {g: {indices: [0], fixed: true}}\n",
+    "region: {indices: [0]}\ngroups: {g: {indices: [0], fixed: true}}\n",
+    "groups: {g: {dmat: {file: missing.dmat, group: 0}, fixed: true}}\n",
+]
+
+
+@pytest.mark.parametrize("text", BAD)
+def test_the_dry_run_refuses_what_deform_refuses_with_the_same_line(tmp_path, text):
+    write_mesh(str(tmp_path / "m.obj"), tube_mesh(rings=4, segments=6))
+    (tmp_path / "h.yaml").write_text(text)
+    runner = CliRunner()
+    info = runner.invoke(main, ["info", str(tmp_path / "m.obj"), str(tmp_path / "h.yaml")])
+    deform = runner.invoke(main, ["deform", str(tmp_path / "m.obj"), str(tmp_path / "h.yaml"),
+                                  "-o", str(tmp_path / "o.obj")])
+    assert info.exit_code == deform.exit_code == 4, (info.output, deform.output)
+    assert info.stderr == deform.stderr
+
+
+@needs_shared
+@pytest.mark.parametrize("mesh", sorted(glob.glob(os.path.join(SHARED, "*.o*"))))
+def test_every_shared_mesh_is_described(mesh):
+    r = CliRunner().invoke(main, ["info", mesh, "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["vertices"] > 0 and d["diagonal"] > 0 and d["up_guess"] in ("+y", "+z")
+
+
+@needs_shared
+def test_the_shared_handle_files_are_described():
+    runner = CliRunner()
+    sel = runner.invoke(main, ["info", os.path.join(SHARED, "cylinder.off"),
+                               os.path.join(SHARED, "cylinder.sel"), "--json"])
+    assert sel.exit_code == 0, sel.output
+    d = json.loads(sel.stdout)
+    assert {g["name"] for g in d["groups"]} == {"fixed", "handle"}
+    assert d["constrained"] + d["free"] == d["vertices"]
+
+
+@pytest.mark.parametrize("name", ["bar-twist", "bar-bend", "bar-twist-animated"])
+def test_the_shipped_configs_are_described(name):
+    from helpers import ROOT
+
+    from srarap_cli.io.handles import load_handles
+    from srarap_cli.io.mesh import read_mesh
+    mesh = os.path.join(ROOT, "sample_meshes", "bar.obj")
+    handles = os.path.join(ROOT, "configs", f"{name}.yaml")
+    c = load_handles(handles, read_mesh(mesh).vertices)
+    r = CliRunner().invoke(main, ["info", mesh, handles, "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert [(g["name"], g["vertices"]) for g in d["groups"]] == \
+        [(g, len(ids)) for g, ids in c.groups.items()]
+    assert d["constrained"] == len(c.ids) and d["constrained"] + d["free"] == d["vertices"]
