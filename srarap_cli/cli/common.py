@@ -3,6 +3,7 @@ import functools
 import math
 import os
 import sys
+import tempfile
 import traceback
 from collections import Counter
 
@@ -10,6 +11,7 @@ import click
 import numpy as np
 
 from ..io.handles import referenced_files
+from ..io.mesh import read_mesh
 from ..runtime import exit_codes, signals, streams
 from ..runtime.clock import elapsed
 from ..runtime.commit import COMMITTED
@@ -183,6 +185,31 @@ def refuse_overwrite(outputs, *, mesh=None, handles=None, others=()):
         inputs += [("file the handle file names", p) for p in referenced_files(handles)]
     refuse_overwriting_inputs([o for o in outputs if o not in (None, "-")],
                               inputs + list(others))
+
+
+def read_stdin_mesh(input_format):
+    """The mesh on standard input, parsed by the reader of ``input_format``."""
+    if input_format is None:
+        raise click.UsageError("MESH '-' (standard input) needs --input-format obj|off|ply|stl")
+    data = sys.stdin.buffer.read()
+    with tempfile.TemporaryDirectory(prefix="srarap-stdin-") as folder:
+        path = os.path.join(folder, "stdin." + input_format)
+        with open(path, "wb") as fh:
+            fh.write(data)
+        try:
+            return read_mesh(path)
+        except InputError as exc:
+            raise InputError(str(exc).replace(path, "<stdin>")) from None
+
+
+def read_any_mesh(path, input_format=None):
+    """``path``, or standard input for ``-`` (in ``input_format``)."""
+    return read_stdin_mesh(input_format) if path == "-" else read_mesh(path)
+
+
+input_format_option = click.option(
+    "--input-format", type=click.Choice(["obj", "off", "ply", "stl"]),
+    help="Format of a mesh given as '-' (standard input).")
 
 
 cache_option = click.option("--cache", type=click.Path(file_okay=False),

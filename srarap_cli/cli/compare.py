@@ -3,11 +3,10 @@ import json
 
 import click
 
-from ..io.mesh import read_mesh
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..tasks.compare import compare_meshes
-from .common import check_output_path, guarded, refuse_overwrite
+from .common import check_output_path, guarded, input_format_option, read_any_mesh, refuse_overwrite
 
 
 @click.command("compare")
@@ -19,8 +18,9 @@ from .common import check_output_path, guarded, refuse_overwrite
               help="Distances as fractions of A's bounding-box diagonal.")
 @click.option("--json", "report", help="Also write the figures to this JSON file.")
 @click.option("-q", "--quiet", is_flag=True, help="No summary line.")
+@input_format_option
 @guarded
-def compare(a, b, tol, relative, report, quiet):
+def compare(a, b, tol, relative, report, quiet, input_format):
     """Compare meshes A and B: per vertex when they have the same vertices and faces, else by
     the symmetric Hausdorff distance of their surfaces.
 
@@ -29,7 +29,9 @@ def compare(a, b, tol, relative, report, quiet):
     if report is not None:
         check_output_path(report, (".json",), "--json")
     refuse_overwrite([report], others=[("mesh A", a), ("mesh B", b)])
-    ma, mb = read_mesh(a), read_mesh(b)
+    if a == b == "-":
+        raise click.UsageError("only one of A and B can be '-' (standard input)")
+    ma, mb = read_any_mesh(a, input_format), read_any_mesh(b, input_format)
     figures = compare_meshes(ma, mb)
     scale = figures["diagonal"] if relative and figures["diagonal"] > 0 else 1.0
     shown = {k: figures[k] / scale for k in ("max", "mean", "rms")}

@@ -2,16 +2,14 @@
 import math
 import os
 import sys
-import tempfile
 
 import click
 
 from ..io.handles import load_handles
-from ..io.mesh import WRITE_FORMATS, format_mesh, read_mesh
+from ..io.mesh import WRITE_FORMATS, format_mesh
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
-from ..runtime.errors import InputError
 from ..runtime.limits import check_solve
 from ..solver.drivers.monitor import recent_changes
 from ..solver.multires.size import AUTO_THRESHOLD
@@ -23,6 +21,8 @@ from .common import (
     cache_option,
     check_output_path,
     guarded,
+    input_format_option,
+    read_any_mesh,
     refuse_overwrite,
     report,
     wall_seconds,
@@ -37,12 +37,13 @@ from .progress import SolveProgress
 @click.argument("mesh")
 @click.argument("handles")
 @click.option("-o", "--output", "out", required=True,
-              help="Deformed mesh to write: .obj, .ply or .off; '-' for standard output "
-                   "(with --format).")
-@click.option("--input-format", type=click.Choice(["obj", "off", "ply", "stl"]),
-              help="Format of MESH when it is '-' (standard input).")
-@click.option("--format", "out_format", type=click.Choice(["obj", "off", "ply"]),
-              help="Format of the output when it is '-' (standard output).")
+              help="Deformed mesh to write: .obj, .ply, .off or .stl (binary); '-' for "
+                   "standard output.")
+@input_format_option
+@click.option("--format", "out_format", type=click.Choice(["obj", "off", "ply", "stl"]),
+              help="Format of the output when it is '-' (standard output). [default: the "
+                   "input's format]")
+@click.option("--ascii", is_flag=True, help="Write PLY as ASCII text (default: binary).")
 @click.option("--log", "log",
               help="Per-iteration energy log: .csv or .jsonl.")
 @settings_options()
@@ -56,7 +57,7 @@ from .progress import SolveProgress
               help="Write the mesh even when the solve did not converge (exit code still 3).")
 @with_verbosity
 @guarded
-def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, preview,
+def deform(mesh, handles, out, input_format, out_format, ascii, log, overrides, cache, preview,
            preview_up, write_distortion, keep_unconverged, verbosity):
     """Deform MESH as rigidly as possible with smooth rotations.
 
@@ -64,7 +65,9 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
     Exit codes: 0 converged, 3 not converged (no mesh written unless --keep-unconverged; the
     log is written), 2 usage, 4 invalid input, 5 numerical failure, 6 output error.
     """
-    suffix = _output_suffix(out, out_format)
+    suffix = _output_suffix(out, out_format, mesh, input_format)
+    if ascii and suffix != ".ply":
+        raise click.UsageError("--ascii applies to PLY output only")
     if out != "-":
         check_output_path(out, WRITE_FORMATS, "output")
     if preview is not None:
@@ -76,7 +79,7 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
         if os.path.abspath(log) == os.path.abspath(out):
             raise click.UsageError("--log and --output name the same file")
     refuse_overwrite([out, log, preview], mesh=mesh, handles=handles)
-    source = read_stdin_mesh(input_format) if mesh == "-" else read_mesh(mesh)
+    source = read_any_mesh(mesh, input_format)
     name = "<stdin>" if mesh == "-" else mesh
     check_solve(name, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
@@ -91,7 +94,7 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
     done = complete(result, opts)
-    mesh_bytes, lost = format_mesh(deformed, suffix)
+    mesh_bytes, lost = format_mesh(deformed, suffix, ascii)
     keep = done or keep_unconverged
     files = [(out, mesh_bytes)] if keep and out != "-" else []
     if preview is not None and keep:
@@ -109,29 +112,16 @@ def deform(mesh, handles, out, input_format, out_format, log, overrides, cache, 
         raise SystemExit(exit_codes.NOT_CONVERGED)
 
 
-def _output_suffix(out, out_format):
+def _output_suffix(out, out_format, mesh, input_format):
     if out == "-":
-        if out_format is None:
-            raise click.UsageError("-o - (standard output) needs --format obj|off|ply")
-        return "." + out_format
+        given = out_format or (input_format if mesh == "-" else
+                               os.path.splitext(mesh)[1].lower().lstrip("."))
+        if "." + str(given) not in WRITE_FORMATS:
+            raise click.UsageError("-o - (standard output) needs --format obj|off|ply|stl")
+        return "." + given
     if out_format is not None and os.path.splitext(out)[1].lower() != "." + out_format:
         raise click.UsageError(f"--format {out_format} does not match the output {out!r}")
     return os.path.splitext(out)[1].lower()
-
-
-def read_stdin_mesh(input_format):
-    """The mesh on standard input, parsed by the reader of ``input_format``."""
-    if input_format is None:
-        raise click.UsageError("MESH '-' (standard input) needs --input-format obj|off|ply|stl")
-    data = sys.stdin.buffer.read()
-    with tempfile.TemporaryDirectory(prefix="srarap-stdin-") as folder:
-        path = os.path.join(folder, "stdin." + input_format)
-        with open(path, "wb") as fh:
-            fh.write(data)
-        try:
-            return read_mesh(path)
-        except InputError as exc:
-            raise InputError(str(exc).replace(path, "<stdin>")) from None
 
 
 def _summary(result, opts, out):

@@ -4,24 +4,23 @@ import json
 import click
 
 from ..io.handles import load_handles
-from ..io.mesh import read_mesh
 from ..tasks.info import handles_info, mesh_info
-from .common import guarded
-from .deform import read_stdin_mesh
+from .common import guarded, input_format_option, read_any_mesh
 
 
 @click.command("info")
 @click.argument("mesh")
 @click.argument("handles", required=False)
-@click.option("--input-format", type=click.Choice(["obj", "off", "ply", "stl"]),
-              help="Format of MESH when it is '-' (standard input).")
+@input_format_option
 @click.option("--json", "as_json", is_flag=True, help="One JSON document on standard output.")
 @guarded
 def info(mesh, handles, input_format, as_json):
-    """Describe MESH (counts, extent per axis, problems) and, with HANDLES, what each group
-    selects and does: a dry run of the checks deform makes (exit 4 when the file is invalid).
+    """Describe MESH and what HANDLES selects and does, without solving.
+
+    The mesh: counts, extent per axis, problems. With HANDLES, each group's vertices and
+    action: a dry run of the checks deform makes (exit 4 when the file is invalid).
     """
-    source = read_stdin_mesh(input_format) if mesh == "-" else read_mesh(mesh)
+    source = read_any_mesh(mesh, input_format)
     name = "<stdin>" if mesh == "-" else mesh
     out = {"mesh": name, **mesh_info(source)}
     if handles is not None:

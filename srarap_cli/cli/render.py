@@ -12,7 +12,7 @@ from ..io.mesh import read_mesh
 from ..runtime.commit import commit_files
 from ..tasks.preview import preview_png
 from ..tasks.render import VIEWS
-from .common import check_output_path, guarded, refuse_overwrite
+from .common import check_output_path, guarded, input_format_option, read_any_mesh, refuse_overwrite
 
 
 def parse_size(text):
@@ -44,8 +44,9 @@ def parse_size(text):
               help=f"{', '.join(VIEWS)}, or a viewing direction 'x,y,z'; repeat for "
                    "several views side by side.")
 @click.option("--size", default="800x600", show_default=True, help="WIDTHxHEIGHT in pixels.")
+@input_format_option
 @guarded
-def render(mesh, out, handles, rest, color, layout, up, views, size):
+def render(mesh, out, handles, rest, color, layout, up, views, size, input_format):
     """Render MESH to a PNG, headless."""
     check_output_path(out, (".png",), "output")
     size = parse_size(size)
@@ -53,7 +54,7 @@ def render(mesh, out, handles, rest, color, layout, up, views, size):
         _check_view(view)
     refuse_overwrite([out], mesh=mesh, handles=handles,
                      others=[("rest mesh", rest)] if rest else [])
-    shown = read_mesh(mesh)
+    shown = read_any_mesh(mesh, input_format)
     base = read_mesh(rest) if rest else None
     if base is not None and len(base.vertices) != len(shown.vertices):
         raise click.BadParameter("the rest mesh must have the same vertices", param_hint="--rest")

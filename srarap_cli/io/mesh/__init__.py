@@ -21,11 +21,11 @@ from .mesh import Mesh
 from .normals import recompute_normals
 from .obj import format_obj, read_obj
 from .off import format_off, read_off
-from .ply import format_ply, mesh_from_meshio, per_vertex
+from .ply import format_ply, format_stl, mesh_from_meshio, per_vertex
 from .ply_read import read_ply
 
 READ_FORMATS = (".obj", ".off", ".ply", ".stl")
-WRITE_FORMATS = (".obj", ".off", ".ply")
+WRITE_FORMATS = (".obj", ".off", ".ply", ".stl")
 
 __all__ = ["READ_FORMATS", "WRITE_FORMATS", "Mesh", "atomic_write", "read_mesh", "write_mesh"]
 
@@ -118,11 +118,17 @@ def _validate(mesh, path):
                          f"but the mesh has vertices 0..{n - 1}")
 
 
-def format_mesh(mesh, suffix):
-    """File content for ``mesh`` in the format of ``suffix``, with warnings for lost data."""
+def format_mesh(mesh, suffix, ascii=False):
+    """File content for ``mesh`` in the format of ``suffix`` (PLY in ASCII with ``ascii``),
+    with warnings for lost data."""
     lost = []
     if suffix == ".obj":
         return format_obj(mesh).encode("utf-8"), lost
+    if suffix == ".stl":
+        if (mesh.face_sizes != 3).any() or mesh.uv is not None or mesh.normals is not None:
+            lost.append("STL keeps only triangles in single precision: polygons split, "
+                        "texture coordinates and normals not written, vertices not shared")
+        return format_stl(mesh), lost
     if mesh.uv is not None and (suffix == ".off" or per_vertex(mesh, mesh.uv, mesh.face_uv) is None):
         lost.append(f"texture coordinates not written: {suffix[1:].upper()} stores at most one "
                     "per vertex; write .obj to keep them")
@@ -130,7 +136,7 @@ def format_mesh(mesh, suffix):
         mesh = _vertex_normals(mesh)
     if suffix == ".off":
         return format_off(mesh).encode("ascii"), lost
-    return format_ply(mesh), lost
+    return format_ply(mesh, ascii), lost
 
 
 def _vertex_normals(mesh):

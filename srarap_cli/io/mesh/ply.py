@@ -38,8 +38,9 @@ def per_vertex(mesh, values, refs):
     return values[first]
 
 
-def format_ply(mesh):
-    """Binary little-endian PLY bytes; per-vertex normals and UVs when they are per vertex."""
+def format_ply(mesh, ascii=False):
+    """PLY bytes, binary little-endian (or ``ascii``); per-vertex normals and UVs when they
+    are per vertex."""
     n = len(mesh.vertices)
     columns = [("x", mesh.vertices[:, 0]), ("y", mesh.vertices[:, 1]), ("z", mesh.vertices[:, 2])]
     normals = per_vertex(mesh, mesh.normals, mesh.face_normals)
@@ -55,12 +56,37 @@ def format_ply(mesh):
     table = np.empty(n, dtype=dtype)
     for name, col in columns:
         table[name] = col
-    header = ["ply", "format binary_little_endian 1.0", "comment written by srarap",
-              f"element vertex {n}"]
+    header = ["ply", f"format {'ascii' if ascii else 'binary_little_endian'} 1.0",
+              "comment written by srarap", f"element vertex {n}"]
     header += [f"property {_PLY_TYPES[table.dtype[name].str[1:]]} {name}" for name, _ in columns]
     header += [f"element face {mesh.face_sizes.size}",
                "property list uchar int vertex_indices", "end_header"]
-    return ("\n".join(header) + "\n").encode("ascii") + table.tobytes() + _face_bytes(mesh)
+    head = ("\n".join(header) + "\n").encode("ascii")
+    if ascii:
+        return head + _ascii_rows(table, mesh)
+    return head + table.tobytes() + _face_bytes(mesh)
+
+
+def _ascii_rows(table, mesh):
+    """Vertex rows with every value written to round-trip (shortest repr), then faces."""
+    cols = [table[name].tolist() for name in table.dtype.names]
+    rows = [" ".join(map(repr, values)) for values in zip(*cols)]
+    faces = np.split(mesh.face_vertices, mesh.face_offsets[1:-1])
+    rows += [" ".join(map(str, [len(f), *f.tolist()])) for f in faces]
+    return ("\n".join(rows) + "\n").encode("ascii")
+
+
+def format_stl(mesh):
+    """Binary STL bytes of the mesh's triangles (polygons fanned), deterministic header."""
+    F = mesh.triangles()[0]
+    tri = mesh.vertices[F]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    normal = np.divide(normal, length, out=np.zeros_like(normal), where=length > 0)
+    record = np.zeros(len(F), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    record["n"], record["v"] = normal, tri
+    header = b"binary STL written by srarap".ljust(80, b" ")
+    return header + np.uint32(len(F)).tobytes() + record.tobytes()
 
 
 def _face_bytes(mesh):
