@@ -1,13 +1,15 @@
-"""Time a manifest of many small jobs run sequentially and with 2 worker processes.
+"""Time a manifest of jobs run with 1 and 2 worker processes and on a local Dask cluster.
 
-Writes small tubes (srarap_cli.tasks.samples, as the sample bar) and a manifest of N jobs bending them,
-runs `srarap batch` with --workers 1 and --workers 2 in fresh output folders, and prints both
-wall times and their ratio. One job is deliberately broken: it must be reported, not fatal.
+Writes tubes (srarap_cli.tasks.samples, as the sample bar) and a manifest of N jobs bending
+them, runs `srarap batch` with --workers 1, --workers 2 and --scheduler local --workers 2 in
+fresh output folders, each --repeat times, and prints the median wall times, jobs per hour and
+the ratios to one worker. One job is deliberately broken: it must be reported, not fatal.
 
-Run: python benchmarks/batch_speedup.py [--jobs 200]
+Run: python benchmarks/batch_speedup.py [--jobs 20] [--rings 60] [--repeat 3]
 """
 import argparse
 import os
+import statistics
 import subprocess
 import tempfile
 import time
@@ -19,14 +21,16 @@ from srarap_cli.tasks.samples import bar, obj_text
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--jobs", type=int, default=200)
+    ap.add_argument("--jobs", type=int, default=20)
+    ap.add_argument("--rings", type=int, default=60, help="tube rings (60: 5k vertices)")
+    ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
     work = tempfile.mkdtemp(prefix="srarap-batch-")
     jobs = []
     for k in range(args.jobs):
         mesh = os.path.join(work, f"tube{k}.obj")
         with open(mesh, "w") as fh:
-            fh.write(obj_text(*bar(length=6, rings=8 + k % 5, segments=8)))
+            fh.write(obj_text(*bar(length=6, rings=args.rings + k % 5, segments=80)))
         handles = os.path.join(work, f"h{k}.yaml")
         with open(handles, "w") as fh:
             yaml.safe_dump({"groups": {
@@ -38,15 +42,25 @@ def main():
     manifest = os.path.join(work, "jobs.yaml")
     with open(manifest, "w") as fh:
         yaml.safe_dump({"defaults": {"max_iter": 200}, "jobs": jobs}, fh)
+    modes = {"--workers 1": ["--workers", "1"], "--workers 2": ["--workers", "2"],
+             "dask local, 2 workers": ["--scheduler", "local", "--workers", "2"]}
     times = {}
-    for workers in (1, 2):
-        start = time.perf_counter()
-        p = subprocess.run(["srarap", "batch", manifest, "-o", os.path.join(work, f"w{workers}"),
-                            "--workers", str(workers), "-q"], check=False)
-        times[workers] = time.perf_counter() - start
-        print(f"--workers {workers}: {times[workers]:.1f} s (exit code {p.returncode}, "
+    for name, extra in modes.items():
+        runs = []
+        for r in range(args.repeat):
+            start = time.perf_counter()
+            p = subprocess.run(["srarap", "batch", manifest, "-o",
+                                os.path.join(work, f"{name.replace(' ', '_')}{r}"), "-q",
+                                *extra], check=False)
+            runs.append(time.perf_counter() - start)
+        times[name] = statistics.median(runs)
+        print(f"{name:24} {times[name]:6.1f} s median of {args.repeat} "
+              f"({3600 * args.jobs / times[name]:7.0f} jobs/hour; exit code {p.returncode}, "
               "8 = the broken job was reported)")
-    print(f"speed-up with 2 workers: {times[1] / times[2]:.2f}x for {args.jobs} jobs")
+    base = times["--workers 1"]
+    for name, t in times.items():
+        print(f"{name:24} {base / t:.2f}x one worker")
+    print(f"dask local / --workers 2: {times['dask local, 2 workers'] / times['--workers 2']:.2f}")
 
 
 if __name__ == "__main__":

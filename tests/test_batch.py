@@ -96,6 +96,27 @@ def test_a_dask_cluster_gives_the_same_results_as_local_workers(tmp_path):
         assert remote_rows[n]["iterations"] == local_rows[n]["iterations"]
 
 
+def test_scheduler_local_starts_single_threaded_workers_without_dasks_trim_setting(tmp_path):
+    """``--scheduler local``: the same bytes as local workers; its workers run one BLAS
+    thread and glibc's own malloc trimming (Dask's nanny default slowed solves 1.8x)."""
+    import functools
+    import os
+
+    from srarap_cli.tasks.batch import _run_on_dask
+
+    jobs = [{"name": "twist", "mesh": BAR, "handles": TWIST, "output": "twist.obj"}]
+    path = manifest(tmp_path, jobs)
+    run(path, tmp_path / "local")
+    dask_run, _ = run(path, tmp_path / "dask", "--scheduler", "local", "--workers", "2")
+    assert dask_run.exit_code == 0, dask_run.output
+    assert (tmp_path / "dask" / "twist.obj").read_bytes() == \
+        (tmp_path / "local" / "twist.obj").read_bytes()
+    probe = functools.partial(lambda job, out_dir: (os.environ.get("MALLOC_TRIM_THRESHOLD_"),
+                                                     os.environ.get("OPENBLAS_NUM_THREADS")),
+                              out_dir=str(tmp_path))
+    assert _run_on_dask([{}, {}], probe, "local", 2) == [(None, "1"), (None, "1")]
+
+
 def test_editing_a_file_the_handle_file_names_makes_the_job_run_again(tmp_path):
     (tmp_path / "move.def").write_text("1 0 0 0.5\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
     (tmp_path / "h.yaml").write_text(yaml.safe_dump({"groups": {

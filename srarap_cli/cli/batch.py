@@ -17,8 +17,11 @@ from .common import guarded
 @click.argument("manifest")
 @click.option("--workers", type=click.IntRange(min=1), default=1, show_default=True,
               help="Worker processes.")
-@click.option("--scheduler", help="Run the jobs on the Dask cluster at this address "
-              "(pip install 'srarap-cli[dask]'); its workers must share this file system.")
+@click.option("--scheduler", help="Run the jobs on Dask (pip install 'srarap-cli[dask]'): "
+              "'local' starts --workers single-threaded worker processes here; an address "
+              "('tcp://host:8786') uses that cluster, whose workers must share this file "
+              "system and should run one thread each (dask worker --nthreads 1) with "
+              "OPENBLAS_NUM_THREADS=1 and without MALLOC_TRIM_THRESHOLD_ set.")
 @click.option("-o", "--output", "out", default=".", show_default=True,
               help="Folder for the jobs' outputs and summary.csv / summary.json.")
 @click.option("--keep-unconverged", is_flag=True,

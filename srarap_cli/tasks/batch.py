@@ -15,6 +15,7 @@ A job is up to date when its output exists and the sidecar ``<output>.srarap.jso
 the same fingerprint (content of the mesh, the handle file and every file it names, settings,
 srarap version).
 """
+import contextlib
 import functools
 import hashlib
 import json
@@ -209,23 +210,62 @@ def run_batch(jobs, out_dir, workers=1, scheduler=None, keep_unconverged=False):
     """
     run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged)
     if scheduler is not None:
-        return _run_on_dask(jobs, run, scheduler)
+        return _run_on_dask(jobs, run, scheduler, workers)
     if workers <= 1:
         return [run(job) for job in jobs]
     with ProcessPoolExecutor(max_workers=workers) as pool:
         return list(pool.map(run, jobs))
 
 
-def _run_on_dask(jobs, run, scheduler):
+#: what srarap's own Dask workers get instead of Dask's defaults: one BLAS thread, and glibc's
+#: dynamic malloc trimming (Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536, which turned each
+#: solve's large temporaries into mmap/munmap pairs: system time 0.23 -> 4.5 s for 20 jobs)
+WORKER_ENVIRON = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1}
+# local workers are forked: a spawned worker imports numpy, scipy, libigl and distributed
+# again (about 1.5 s for two), which made 20 jobs of 5k vertices take 4.7 s against 3.2 s
+# with --workers 2; forked, 1.03x of --workers 2 (benchmarks/batch_speedup.py)
+
+
+def _run_on_dask(jobs, run, scheduler, workers):
+    """On the cluster at ``scheduler``, or on a local one of ``workers`` single-threaded
+    worker processes when ``scheduler`` is ``local``."""
     try:
-        from distributed import Client
+        import dask
+        from distributed import Client, LocalCluster
     except ImportError:
         raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
     run = functools.partial(run, out_dir=os.path.abspath(run.keywords["out_dir"]))
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": WORKER_ENVIRON,
+                          "distributed.worker.multiprocessing-method": "fork"}):
+        cluster = None
+        if scheduler == "local":
+            with _without_dasks_trim_setting():
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
+                                       processes=True, dashboard_address=None)
+        try:
+            return _gather(Client(cluster or scheduler, timeout=30), jobs, run)
+        except (OSError, TimeoutError) as exc:
+            raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+        finally:
+            if cluster is not None:
+                cluster.close()
+
+
+@contextlib.contextmanager
+def _without_dasks_trim_setting():
+    """A Dask nanny started earlier in this process left its MALLOC_TRIM_THRESHOLD_ in
+    ``os.environ``, where new workers would inherit it: hold it back while they spawn."""
+    value = os.environ.get("MALLOC_TRIM_THRESHOLD_")
+    if value == "65536":
+        del os.environ["MALLOC_TRIM_THRESHOLD_"]
     try:
-        client = Client(scheduler, timeout=30)
-    except (OSError, TimeoutError) as exc:
-        raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+        yield
+    finally:
+        if value == "65536":
+            os.environ["MALLOC_TRIM_THRESHOLD_"] = value
+
+
+def _gather(client, jobs, run):
     with client:
         futures = client.map(run, jobs, pure=False)
         return client.gather(futures)
