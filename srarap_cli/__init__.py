@@ -21,10 +21,13 @@ __all__ = sorted(_WHERE)
 
 
 def __getattr__(name):
+    if name == "__version__":  # one source, pyproject.toml; read on demand (importlib.metadata)
+        from importlib.metadata import version
+        return version("srarap-cli")
     if name not in _WHERE:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     return getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
 
 
 def __dir__():
-    return sorted(list(globals()) + __all__)
+    return sorted(list(globals()) + __all__ + ["__version__"])

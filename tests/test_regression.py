@@ -21,7 +21,7 @@ SEGMENTS = 16
 
 
 def golden(name):
-    return read_mesh(os.path.join(HERE, "golden", f"{name}.obj")).vertices
+    return read_mesh(os.path.join(ROOT, "srarap_cli", "data", "golden", f"{name}.obj")).vertices
 
 
 def test_goldens_meet_their_constraints_exactly():

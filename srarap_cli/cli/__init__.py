@@ -26,6 +26,8 @@ COMMANDS = {
     "info": ("info", "info", "Describe MESH and what HANDLES selects and does, without "
                              "solving."),
     "render": ("render", "render", "Render MESH to a PNG, headless."),
+    "samples": ("samples", "samples", "Copy the sample meshes, handle files and goldens into "
+                                      "FOLDER (three subfolders)."),
     "plot": ("render", "plot", "Plot total energy against iteration and time for one or more "
                                "deform logs (CSV/JSONL)."),
 }

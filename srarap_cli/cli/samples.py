@@ -1,0 +1,40 @@
+"""``srarap samples``: copy the shipped sample meshes and handle files into a folder."""
+import os
+from importlib import resources
+
+import click
+
+from ..runtime.commit import commit_files
+from ..runtime.errors import OutputError
+from .common import guarded
+
+#: what is copied: meshes, handle files and a batch manifest, and the goldens it checks against
+SUBFOLDERS = ("sample_meshes", "configs", "golden")
+
+
+@click.command("samples")
+@click.argument("folder")
+@click.option("--force", is_flag=True, help="Replace files of the same names in FOLDER.")
+@guarded
+def samples(folder, force):
+    """Copy the sample meshes, handle files and goldens into FOLDER (three subfolders).
+
+    Then, for example: srarap deform FOLDER/sample_meshes/bar.obj FOLDER/configs/bar-twist.yaml
+    -o twisted.obj
+    """
+    data = resources.files("srarap_cli") / "data"
+    files = [(os.path.join(folder, sub, item.name), item.read_bytes())
+             for sub in SUBFOLDERS for item in sorted(
+                 (data / sub).iterdir(), key=lambda p: p.name)
+             if item.is_file() and not item.name.endswith(".py")]
+    clash = [path for path, _ in files if os.path.exists(path)]
+    if clash and not force:
+        raise OutputError(f"{clash[0]}: exists (and {len(clash) - 1} more); --force replaces "
+                          "them")
+    for sub in SUBFOLDERS:
+        try:
+            os.makedirs(os.path.join(folder, sub), exist_ok=True)
+        except OSError as exc:
+            raise OutputError(f"{folder}: cannot create folder: {exc.strerror}") from None
+    commit_files(files)
+    click.echo(f"srarap samples: wrote {len(files)} files to {folder}", err=True)
