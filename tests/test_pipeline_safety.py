@@ -1,7 +1,6 @@
 """A failed or unconverged run must not look like a finished one to make, batch or a script."""
 import json
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -72,11 +71,8 @@ def test_batch_remembers_a_job_that_did_not_converge(folder):
     assert batch(folder, "{max_iter: 1000}") == (0, "up-to-date")
 
 
-def test_the_readme_batch_example_is_the_shipped_file_and_passes_as_written(tmp_path):
-    readme = open(os.path.join(ROOT, "README.md"), encoding="utf-8").read()
-    block = re.search(r"```yaml\n(# configs/example-jobs.yaml.*?)```", readme, re.S).group(1)
+def test_the_shipped_batch_example_passes_as_written(tmp_path):
     path = os.path.join(ROOT, "configs", "example-jobs.yaml")
-    assert open(path, encoding="utf-8").read() == block
     p = subprocess.run([sys.executable, "-m", "srarap_cli", "batch", path, "-o",
                         str(tmp_path)], capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, p.stderr

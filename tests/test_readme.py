@@ -26,3 +26,33 @@ def test_readme_handle_example_loads(tmp_path):
     assert set(c.groups) == {"base", "tip", "ears", "paw", "tail"}
     assert c.solver["alpha"] == 0.14 and c.region is not None and len(c.tracks) == 1
     assert all(len(ids) for ids in c.groups.values())
+
+
+def test_the_tour_runs_as_written(tmp_path):
+    """Every block of the README's tour, in order, in an empty folder (Python blocks through
+    the same interpreter), must succeed."""
+    import subprocess
+    import sys
+
+    text = Path(ROOT, "README.md").read_text(encoding="utf-8")
+    tour = text[text.index("## A five-minute tour"):text.index("## Handle files")]
+    blocks = re.findall(r"```(sh|python)\n(.*?)```", tour, re.DOTALL)
+    assert len(blocks) >= 6
+    script = "set -e\n" + "".join(
+        body if kind == "sh" else f"python3 - <<'PYBLOCK'\n{body}PYBLOCK\n"
+        for kind, body in blocks)
+    bindir = os.path.dirname(sys.executable)  # python3 and srarap of this environment
+    env = {**os.environ, "PATH": bindir + os.pathsep + os.environ["PATH"]}
+    p = subprocess.run(["bash", "-c", script],
+                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stdout[-2000:] + p.stderr[-2000:]
+    assert (tmp_path / "demo" / "pushed.obj").exists() and "2 jobs: 2 ok" in p.stderr
+
+
+def test_the_options_table_is_the_settings_table():
+    from srarap_cli.cli.options import markdown_table
+    assert markdown_table() in Path(ROOT, "README.md").read_text(encoding="utf-8")
+
+
+def test_the_readme_stays_a_front_door():
+    assert len(Path(ROOT, "README.md").read_bytes()) <= 25_000

@@ -58,3 +58,12 @@ def settings_options(*, exclude=(), defaults=None):
         return wrapper
 
     return decorate
+
+
+def markdown_table() -> str:
+    """The solver settings as the README's Markdown table (a test keeps the two equal)."""
+    rows = ["| option | default | meaning |", "|---|---|---|"]
+    for s in SETTINGS:
+        default = "none" if s.default is None else f"`{s.default}`"
+        rows.append(f"| `{s.flag}` | {default} | {s.help} |")
+    return "\n".join(rows) + "\n"

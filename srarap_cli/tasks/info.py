@@ -76,12 +76,14 @@ def describe_motion(rest, targets):
     q = q[0] if determined.all() else IDENTITY
     q = q if q[0] >= 0 else -q
     angle = float(np.degrees(2 * np.arctan2(np.linalg.norm(q[1:]), q[0])))
+    scale = max(np.abs(rest).max(), 1.0)
     c, d = rest.mean(axis=0), targets.mean(axis=0) - rest.mean(axis=0)
+    c[np.abs(c) < 1e-12 * scale] = 0.0  # rounding noise of a centroid on an axis
     words = []
     if angle > 1e-9:
         axis = q[1:] / np.linalg.norm(q[1:])
         words.append(f"rotate {angle:.6g} degrees about {_direction(axis)} through {_vec(c)}")
-    if np.linalg.norm(d) > 1e-12 * max(np.abs(rest).max(), 1.0):
+    if np.linalg.norm(d) > 1e-12 * scale:
         words.append(f"translate {_vec(d)}")
     text = ", then ".join(words) or "fixed"
     if determined.all():
