@@ -12,6 +12,10 @@ UP = {"z": np.eye(3), "-z": np.diag([1.0, -1, -1]),
       "-x": np.array([[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]])}
 
 
+#: the distortion colour bar ends here, so that a few outliers do not wash out the rest
+CLIP_PERCENTILE = 99
+
+
 def preview_png(mesh, rest=None, constraints=None, color="shade", layout="ghost", view="iso",
                 size=(800, 600), up="y"):
     """PNG bytes of ``mesh`` (and its ``rest`` shape), handles coloured or distortion mapped;
@@ -24,9 +28,11 @@ def preview_png(mesh, rest=None, constraints=None, color="shade", layout="ghost"
     colorbar = None
     if color == "distortion":
         d = vertex_distortion(rest.vertices, mesh.vertices, F)
-        vmax = max(float(d.max()), 1e-12)
+        vmax = max(float(np.percentile(d, CLIP_PERCENTILE)), 1e-12)
         colors = face_colors(F, scalar=d, vmax=vmax)
-        colorbar = ("distortion (relative strain)", vmax)
+        clipped = f", clipped at the {CLIP_PERCENTILE}th percentile (max {d.max():.3g})" \
+            if d.max() > vmax else ""
+        colorbar = (f"distortion (relative strain){clipped}", vmax)
     else:
         colors = face_colors(F, groups)
     current = [(mesh.vertices, F, colors, 1.0)]
@@ -36,4 +42,9 @@ def preview_png(mesh, rest=None, constraints=None, color="shade", layout="ghost"
         rest_item = (rest.vertices, F, face_colors(F, groups), 1.0)
         panels = [[rest_item], current] if layout == "side" else \
             [[(rest.vertices, F, face_colors(F), 0.25)] + current]
-    return render_png(panels, size, view, colorbar)
+    lo, hi = mesh.vertices.min(axis=0) @ turn.T, mesh.vertices.max(axis=0) @ turn.T
+    extent = np.abs(hi - lo)
+    note = "extent " + ", ".join(f"{a} {e:.4g}" for a, e in zip("xyz", extent))
+    legend = list(constraints.groups) if constraints is not None and color != "distortion" \
+        else None
+    return render_png(panels, size, view, colorbar, legend=legend, axes=turn, note=note)

@@ -7,9 +7,12 @@ import io
 
 import numpy as np
 
-VIEWS = {"front": ([0, -1, 0], [0, 0, 1]), "back": ([0, 1, 0], [0, 0, 1]),
+# Viewing directions (camera to scene) in the renderer's z-up frame, where a y-up mesh's front
+# (+z, OBJ's convention) lands on -y as a z-up mesh's front does (Blender's): "front" looks
+# along +y at that side. (It looked along -y before and showed the back of y-up meshes.)
+VIEWS = {"front": ([0, 1, 0], [0, 0, 1]), "back": ([0, -1, 0], [0, 0, 1]),
          "left": ([1, 0, 0], [0, 0, 1]), "right": ([-1, 0, 0], [0, 0, 1]),
-         "top": ([0, 0, -1], [0, 1, 0]), "iso": ([-1, -1, -0.8], [0, 0, 1])}
+         "top": ([0, 0, -1], [0, 1, 0]), "iso": ([-1, 1, -0.8], [0, 0, 1])}
 BASE = np.array([0.78, 0.78, 0.80])
 PALETTE = np.array([[0.90, 0.30, 0.25], [0.20, 0.50, 0.90], [0.25, 0.75, 0.35],
                     [0.95, 0.65, 0.15], [0.60, 0.35, 0.80], [0.10, 0.75, 0.75]])
@@ -63,6 +66,23 @@ def _frame(axes, boxes):
         ax.set_aspect("equal", adjustable="box")
 
 
+def _triad(fig, left, view, model_axes):
+    """Arrows for the model's x, y, z as the view sees them, in a corner of the view."""
+    _, up, right = camera(view)
+    ax = fig.add_axes([left + 0.01, 0.04, 0.09, 0.12])
+    ax.set_axis_off()
+    ax.set_xlim(-1.3, 1.3)
+    ax.set_ylim(-1.3, 1.3)
+    ax.set_aspect("equal")
+    for k, (label, color) in enumerate(zip("xyz", ("#d62728", "#2ca02c", "#1f77b4"))):
+        x, y = model_axes[k] @ right, model_axes[k] @ up
+        if np.hypot(x, y) < 0.15:  # pointing at or away from the viewer: a dot
+            ax.plot(0, 0, "o", color=color, ms=3)
+        else:
+            ax.annotate("", (x, y), (0, 0), arrowprops={"arrowstyle": "->", "color": color})
+        ax.text(1.15 * x, 1.15 * y, label, color=color, fontsize=7, ha="center", va="center")
+
+
 def face_colors(F, vertex_groups=None, scalar=None, vmax=None):
     """Per-face RGB: base grey, handle groups from the palette, or a viridis scalar."""
     if scalar is not None:
@@ -78,7 +98,8 @@ def face_colors(F, vertex_groups=None, scalar=None, vmax=None):
     return out
 
 
-def render_png(panels, size=(800, 600), view="iso", colorbar=None):
+def render_png(panels, size=(800, 600), view="iso", colorbar=None, legend=None, axes=None,
+               note=None):
     """PNG bytes of one or more panels side by side, for one or more views.
 
     Parameters
@@ -88,6 +109,10 @@ def render_png(panels, size=(800, 600), view="iso", colorbar=None):
     view : a VIEWS name or 'x,y,z' viewing direction, or a list of them: every view gets its
         own columns (one per panel), framed alike within the view
     colorbar : (label, vmax) to add a viridis colour bar, optional
+    legend : list of str, optional, the names of the palette's colours in order (groups)
+    axes : (3, 3) float array, optional, the model's x, y, z axes in the renderer's frame:
+        a triad in the lower left corner of each view shows them
+    note : str, optional, a line of text at the bottom (e.g. the mesh's extent)
     """
     import matplotlib
     matplotlib.use("Agg")
@@ -97,7 +122,8 @@ def render_png(panels, size=(800, 600), view="iso", colorbar=None):
 
     dpi = 100
     fig = plt.figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
-    width = 0.88 if colorbar else 1.0
+    width = 0.86 if colorbar else 1.0
+    triad = axes
     views = [view] if isinstance(view, str) else list(view)
     columns = len(views) * len(panels)
     for v, name in enumerate(views):
@@ -109,10 +135,20 @@ def render_png(panels, size=(800, 600), view="iso", colorbar=None):
             boxes += [draw(ax, V, F, c, name, a) for V, F, c, a in meshes]
             axes.append(ax)
         _frame(axes, boxes)
+        if triad is not None:
+            _triad(fig, v * len(panels) * width / columns, name, triad)
     if colorbar:
-        cax = fig.add_axes([0.91, 0.1, 0.025, 0.8])
-        fig.colorbar(ScalarMappable(Normalize(0, colorbar[1]), "viridis"), cax=cax,
-                     label=colorbar[0])
+        cax = fig.add_axes([0.895, 0.12, 0.022, 0.76])
+        bar = fig.colorbar(ScalarMappable(Normalize(0, colorbar[1]), "viridis"), cax=cax)
+        bar.set_label(colorbar[0], fontsize=7, labelpad=2)
+        bar.ax.tick_params(labelsize=7)
+    if legend:
+        from matplotlib.patches import Patch
+        fig.legend(handles=[Patch(color=PALETTE[k % len(PALETTE)], label=text)
+                            for k, text in enumerate(legend)], loc="upper left", fontsize=8,
+                   frameon=False)
+    if note:
+        fig.text(0.01, 0.01, note, fontsize=7, color="0.3")
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi, metadata={"Software": None})
     plt.close(fig)
