@@ -9,6 +9,7 @@ and constraint set), ``solve`` to each ``solve`` call, ``build`` chooses the sol
 """
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from .local_step import METHODS
 from .multires.size import AUTO_RATIO, AUTO_SIZE, AUTO_THRESHOLD, parse_size
@@ -120,7 +121,7 @@ SETTINGS = (
             "build", choices=("refine", "transfer")),
 )
 BY_NAME = {s.name: s for s in SETTINGS}
-DEFAULTS = {s.name: s.default for s in SETTINGS}
+DEFAULTS: dict[str, Any] = {s.name: s.default for s in SETTINGS}
 NAMES = tuple(BY_NAME)
 
 

@@ -37,7 +37,7 @@ class Problem:
     ids: np.ndarray
     targets: np.ndarray
     labels: np.ndarray
-    area: float = None
+    area: float | None = None
     sub: object = None
 
     def targets_for(self, constraint_targets):

@@ -44,7 +44,7 @@ class Constraints:
     ids: np.ndarray
     targets: np.ndarray
     groups: dict = field(default_factory=dict)
-    region: np.ndarray = None
+    region: np.ndarray | None = None
     solver: dict = field(default_factory=dict)
     tracks: list = field(default_factory=list)
 

@@ -60,7 +60,8 @@ def read_mesh(path: str | os.PathLike) -> Mesh:
     except InputError:
         raise
     except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+        raise InputError(f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}") \
+            from None
     _validate(mesh, path)
     return mesh
 

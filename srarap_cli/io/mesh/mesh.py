@@ -25,10 +25,10 @@ class Mesh:
     vertices: np.ndarray
     face_sizes: np.ndarray
     face_vertices: np.ndarray
-    uv: np.ndarray = None
-    face_uv: np.ndarray = None
-    normals: np.ndarray = None
-    face_normals: np.ndarray = None
+    uv: np.ndarray | None = None
+    face_uv: np.ndarray | None = None
+    normals: np.ndarray | None = None
+    face_normals: np.ndarray | None = None
     vertex_data: dict = field(default_factory=dict)
     statements: list = field(default_factory=list)
 
