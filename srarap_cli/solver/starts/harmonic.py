@@ -25,13 +25,20 @@ def harmonic_start(step, initial=None):
     -------
     State
     """
+    R = spread_handle_rotors(step, step.deformer.V)
+    return step.state(step.positions(R), R)
+
+
+def spread_handle_rotors(step, P):
+    """Rotors (n, 4): each handle group's best-fit rotation from its vertices' positions in
+    ``P`` (n, 3) to the step's targets, spread harmonically (immovable vertices keep the
+    identity) and normalized."""
     d = step.deformer
-    held = np.tile(IDENTITY, (d.fixed.size, 1))  # immovable vertices keep the identity
-    held[d.constrained_slots] = handle_rotors(d.V[d.constrained], step.targets, d.labels)
+    held = np.tile(IDENTITY, (d.fixed.size, 1))
+    held[d.constrained_slots] = handle_rotors(P[d.constrained], step.targets, d.labels)
     # the Poisson factorization is the Dirichlet Laplacian of the held vertices: reuse it
     R = d.poisson.bind(held)(np.zeros((len(d.V), 4)))
-    R = normalize(R, np.broadcast_to(IDENTITY, R.shape))
-    return step.state(step.positions(R), R)
+    return normalize(R, np.broadcast_to(IDENTITY, R.shape))
 
 
 def handle_rotors(rest, targets, labels):

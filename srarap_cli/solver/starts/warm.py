@@ -12,8 +12,8 @@ after one more global step.
 """
 import numpy as np
 
-from ..quaternion import IDENTITY, multiply, normalize
-from .harmonic import handle_rotors
+from ..quaternion import multiply, normalize
+from .harmonic import spread_handle_rotors
 
 
 def warm_start(step, initial):
@@ -27,10 +27,5 @@ def warm_start(step, initial):
         raise ValueError("the warm start needs initial=(positions, rotors)")
     P = np.array(initial[0], dtype=float)
     R = np.array(initial[1], dtype=float)
-    d = step.deformer
-    held = np.tile(IDENTITY, (d.fixed.size, 1))
-    held[d.constrained_slots] = handle_rotors(P[d.constrained], step.targets, d.labels)
-    change = d.poisson.bind(held)(np.zeros((len(d.V), 4)))
-    change = normalize(change, np.broadcast_to(IDENTITY, change.shape))
-    R = normalize(multiply(change, R), R)
+    R = normalize(multiply(spread_handle_rotors(step, P), R), R)
     return step.state(step.positions(R), R)
