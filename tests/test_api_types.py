@@ -59,7 +59,6 @@ def test_handles_as_ids_and_targets_match_the_handle_file(case):
 
 def test_the_array_form_still_works(case):
     V, F, _ = case
-    c = srarap_cli.load_handles  # noqa: F841 -- the module attribute resolves
     r = srarap_cli.deform(V, F, [0, 1, 2], V[[0, 1, 2]] + 1.0)
     assert r.converged
 
