@@ -56,3 +56,27 @@ def test_the_options_table_is_the_settings_table():
 
 def test_the_readme_stays_a_front_door():
     assert len(Path(ROOT, "README.md").read_bytes()) <= 25_000
+
+
+def test_the_handle_file_guide_names_every_key_the_schema_knows():
+    from srarap_cli.io.handles.schema import handle_schema
+    guide = Path(ROOT, "docs", "guides", "handle-files.md").read_text(encoding="utf-8")
+    schema = handle_schema()
+    group = schema["properties"]["groups"]["additionalProperties"]["properties"]
+    rotate = group["rotate"]["properties"]
+    for key in [*schema["properties"], *group, *rotate]:
+        assert f"`{key}`" in guide, key
+
+
+def test_the_guides_manifest_example_is_a_valid_manifest(tmp_path):
+    from srarap_cli.tasks.batch import load_manifest
+    guide = Path(ROOT, "docs", "guides", "workflows.md").read_text(encoding="utf-8")
+    block = re.search(r"```yaml\n(.*?)```", guide, re.DOTALL).group(1)
+    (tmp_path / "configs").mkdir()  # the samples' layout, as `srarap samples` writes it
+    os.symlink(Path(ROOT, "sample_meshes"), tmp_path / "sample_meshes")
+    os.symlink(Path(ROOT, "srarap_cli", "data", "golden"), tmp_path / "golden")
+    path = tmp_path / "configs" / "guide-example.yaml"
+    path.write_text(block)
+    jobs = load_manifest(str(path))
+    assert [j["name"] for j in jobs] == ["bar-twist"] and os.path.exists(jobs[0]["mesh"])
+    assert os.path.exists(jobs[0]["expect"]["golden"])

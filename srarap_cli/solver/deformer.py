@@ -135,9 +135,8 @@ class Deformer:
         rotation-aware start fits one rotation per group); default: the connected patches
         the constrained vertices form
     prepare : bool, factor and build the local step now (False: on first use, for a
-        multiresolution solver that may only need the fine mesh's energy)
-
-    Defaults are those of :mod:`srarap_cli.solver.settings`.
+        multiresolution solver that may only need the fine mesh's energy); the other
+        defaults are those of :mod:`srarap_cli.solver.settings`
 
     Attributes
     ----------
