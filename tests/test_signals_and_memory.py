@@ -89,10 +89,14 @@ def test_a_signal_during_the_simplification_with_the_setup_beside_it(case, delay
     """The full-resolution setup runs in a background thread while the main thread
     simplifies: the signal must end the run with 143, never 120 or a segfault."""
     write_mesh(str(case / "big.obj"), tube_mesh(length=10.0, rings=160, segments=150))
+    # the real simplification, then a pause: the signal lands in it or in the pause, with the
+    # setup thread alive, and the run cannot end before it
     patch = ("import srarap_cli.solver.multires.simplify as sm\nreal = sm.simplify_to_subset\n"
              "def slow(*a, **k):\n"
              "    open('simplifying', 'w').close()\n"
-             "    return real(*a, **k)\n"
+             "    out = real(*a, **k)\n"
+             "    time.sleep(5)\n"
+             "    return out\n"
              "sm.simplify_to_subset = slow\n")
     p = _start(case, patch, "deform", "big.obj", "h.yaml", "-o", "o.obj", "--multires",
                "2000")
@@ -100,8 +104,6 @@ def test_a_signal_during_the_simplification_with_the_setup_beside_it(case, delay
     time.sleep(delay)
     p.send_signal(signal.SIGTERM)
     _, err = p.communicate(timeout=60)
-    if p.returncode == 0:  # the run finished before the signal: nothing to check
-        pytest.skip("the solve ended before the signal")
     assert p.returncode == 143, err
     assert err == "srarap: error: terminated; no output written\n"
     assert (case / "o.obj").read_text() == "old result\n"
@@ -138,8 +140,7 @@ def test_running_out_of_memory_is_exit_4_and_one_line(big, limit):
     p = _run_limited(big, limit, {"SRARAP_MEMORY_LIMIT": "1e12"}, "deform", "big.obj",
                      "h.yaml", "-o", "o.obj", "--multires", "off")
     assert time.perf_counter() - start < 100  # a hang is the failure; timing not asserted tighter
-    if p.returncode == 0:
-        pytest.skip("the solve fitted in the limit on this machine")
+    # 48k vertices direct need about 0.9 GB of address space: both limits are too small
     assert p.returncode == 4, p.stderr
     assert p.stderr.startswith("srarap: error: out of memory") and p.stderr.count("\n") == 1
     assert (big / "o.obj").read_text() == "old result\n"

@@ -1,5 +1,6 @@
 """Mesh problems the solve survives, reported as warnings with counts."""
 import numpy as np
+import scipy.sparse as sp
 
 from .libigl import igl
 
@@ -50,6 +51,13 @@ def unique_rows(a):
     s = a[np.lexsort(a.T[::-1])]
     start = np.flatnonzero(np.concatenate([[True], np.any(s[1:] != s[:-1], axis=1)]))
     return s[start], np.diff(np.append(start, len(s)))
+
+
+def edge_adjacency(F, n):
+    """(n, n) sparse matrix, nonzero where two vertices share an edge of ``F`` (f, 3)."""
+    i = F[:, [0, 1, 2, 1, 2, 0]].ravel()
+    j = F[:, [1, 2, 0, 0, 1, 2]].ravel()
+    return sp.csr_matrix((np.ones(i.size), (i, j)), shape=(n, n))
 
 
 def edge_counts(F):

@@ -6,7 +6,7 @@ from scipy.sparse import csgraph
 from ..io.handles import Constraints
 from ..io.mesh import Mesh
 from ..solver.group_rotations import group_rotors
-from ..solver.mesh_checks import edge_counts, mesh_warnings
+from ..solver.mesh_checks import edge_adjacency, edge_counts, mesh_warnings
 from ..solver.quaternion import IDENTITY, to_matrix
 from .pipeline import problem
 
@@ -106,8 +106,7 @@ def _vec(v):
 
 
 def _components(F, n):
-    A = sp.csr_matrix((np.ones(3 * len(F)), (F.ravel(), np.roll(F, 1, axis=1).ravel())),
-                      shape=(n, n))
+    A = edge_adjacency(F, n)
     used = np.zeros(n, bool)
     used[F.ravel()] = True
     labels = csgraph.connected_components(A, directed=False)[1]

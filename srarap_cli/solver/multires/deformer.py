@@ -6,7 +6,6 @@ from dataclasses import dataclass, field
 from functools import partial
 
 import numpy as np
-import scipy.sparse as sp
 
 from ...runtime.errors import NumericalError
 from ...runtime.threads import background, single_threaded
@@ -14,6 +13,7 @@ from .. import api_checks
 from ..deformer import ACCEL_DRIVERS, Deformer, DeformResult
 from ..drivers.anderson import anderson_iteration
 from ..group_rotations import connected_groups, group_rotors
+from ..mesh_checks import edge_adjacency
 from ..quaternion import IDENTITY
 from ..settings import DEFAULTS
 from ..starts import STARTS
@@ -80,13 +80,6 @@ class MultiresResult(DeformResult):
         return [f"srarap: multires: {info['vertices']} of {info['of']} vertices{cached}; {times}"]
 
 
-def _adjacency(F, n):
-    """(n, n) sparse matrix, nonzero where two vertices share an edge of ``F``."""
-    i = F[:, [0, 1, 2, 1, 2, 0]].ravel()
-    j = F[:, [1, 2, 0, 0, 1, 2]].ravel()
-    return sp.csr_matrix((np.ones(i.size), (i, j)), shape=(n, n))
-
-
 def _all_iterations(result):
     """Every iteration ``result`` ran, on every level."""
     return result.iterations + result.coarse_iterations
@@ -145,7 +138,7 @@ class MultiresDeformer:
         start = time.perf_counter()
         self.V, self.F = api_checks.mesh_arrays(V, F)
         self.constrained = api_checks.vertex_ids(constrained, len(self.V))
-        self.labels = (connected_groups(_adjacency(self.F, len(self.V)), self.constrained)
+        self.labels = (connected_groups(edge_adjacency(self.F, len(self.V)), self.constrained)
                        if labels is None else np.asarray(labels, np.int64))
         self.n_groups = int(self.labels.max(initial=-1)) + 1
         groups = [self.constrained[self.labels == g] for g in range(self.n_groups)]
