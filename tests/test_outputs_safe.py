@@ -139,3 +139,25 @@ def test_a_batch_job_whose_sidecar_cannot_be_written_leaves_its_mesh_as_it_was(f
     p = _run(folder, "batch", "jobs.yaml", "-o", "out")
     assert p.returncode == 8, p.stderr
     assert (folder / "out" / "o.obj").read_bytes() == b"previous mesh"
+
+
+def test_a_file_size_limit_mid_write_leaves_every_output_as_it_was(folder):
+    """RLIMIT_FSIZE below the mesh's size: the write fails with EFBIG (Python ignores
+    SIGXFSZ), reported against the user's file; the old mesh and log stay, nothing is left."""
+    import resource
+
+    (folder / "o.obj").write_bytes(b"previous mesh")
+    (folder / "o.csv").write_bytes(b"previous log")
+    limit = 4096  # the log fits, the mesh (about 40 KB) does not
+
+    def small_files():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "m.obj", "h.yaml", "-o",
+                        "o.obj", "--log", "o.csv"], cwd=folder, capture_output=True, text=True,
+                       timeout=120, preexec_fn=small_files)
+    assert p.returncode == 6, p.stderr
+    assert p.stderr.startswith("srarap: error: o.obj: cannot write") and p.stderr.count("\n") == 1
+    assert (folder / "o.obj").read_bytes() == b"previous mesh"
+    assert (folder / "o.csv").read_bytes() == b"previous log"
+    assert not [p for p in os.listdir(folder) if p.startswith(".srarap-")]
