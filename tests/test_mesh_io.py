@@ -1,6 +1,7 @@
 """Reading and writing meshes: order, polygons, UVs, normals, determinism."""
 import glob
 import os
+import re
 
 import meshio
 import numpy as np
@@ -171,3 +172,45 @@ def test_stl_corners_are_welded_into_shared_vertices(tmp_path, binary):
     tri = back.vertices[back.face_vertices.reshape(-1, 3)]
     assert np.allclose(np.sort(tri.reshape(-1, 9), axis=0),
                        np.sort(mesh.vertices[F].reshape(-1, 9).astype(np.float32), axis=0))
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_stl_reads_the_same_vertices_in_the_same_order_as_meshio(tmp_path, binary):
+    """meshio (a test dependency only) is the independent reader: same welding, same order."""
+    from srarap_cli.io.mesh.stl import read_stl
+    spot = read_mesh(os.path.join(ROOT, "sample_meshes", "spot.obj"))
+    path = str(tmp_path / "spot.stl")
+    meshio.write(path, meshio.Mesh(spot.vertices, [("triangle", spot.triangles()[0])]),
+                 binary=binary)
+    ours, theirs = read_stl(path), meshio.read(path)
+    assert np.array_equal(ours.vertices, theirs.points)
+    assert np.array_equal(ours.face_vertices.reshape(-1, 3), theirs.cells[0].data)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+     "endloop\nendfacet\n", "no 'endsolid'"),
+    ("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+     "endloop\nendfacet\nendsolid t\n", "facet 0 is incomplete"),
+    ("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+     "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+     "vertx 0 1 1\nendloop\nendfacet\nendsolid t\n", "facet 1: expected 'vertex'"),
+    ("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 zero 0\nvertex 0 1 0\n"
+     "endloop\nendfacet\nendsolid t\n", "not a number"),
+    ("\x00" * 100, "does not match its triangle count"),
+])
+def test_broken_stl_is_refused_with_what_is_wrong(tmp_path, text, message):
+    path = tmp_path / "broken.stl"
+    path.write_text(text)
+    with pytest.raises(InputError, match=re.escape(message)):
+        read_mesh(str(path))
+
+
+def test_ascii_stl_welds_shared_corners_and_keeps_its_name_tokens(tmp_path):
+    path = tmp_path / "two.stl"
+    facet = "facet normal 0 0 1\n outer loop\n  vertex {}\n  vertex {}\n  vertex {}\n endloop\nendfacet\n"
+    path.write_text("solid my part\n" + facet.format("0 0 0", "1 0 0", "0 1 0")
+                    + facet.format("1 0 0", "1 1 0", "0 1 0") + "endsolid my part\n")
+    mesh = read_mesh(str(path))
+    assert mesh.vertices.tolist() == [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]
+    assert mesh.face_vertices.tolist() == [0, 1, 2, 1, 3, 2]

@@ -74,7 +74,7 @@ class DeformResult:
         return trimesh.Trimesh(vertices=V, faces=F, process=False)
 
     def to_meshio(self):
-        """A ``meshio.Mesh`` of the deformed shape."""
+        """A ``meshio.Mesh`` of the deformed shape (needs meshio installed)."""
         import meshio
 
         V, F = self.to_arrays()

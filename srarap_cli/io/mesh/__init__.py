@@ -1,28 +1,24 @@
 """Read and write meshes, keeping vertex order, polygons, UVs and normals.
 
-OBJ, OFF and PLY are parsed here (meshio fails on common variants of OBJ and OFF, and trusts
-PLY headers); STL is read with meshio. Writers are deterministic (no timestamps) and atomic (temporary file in
-the target folder, then rename), so a failed run never leaves a partial file behind.
+All four formats are parsed here: meshio fails on common variants of OBJ and OFF, trusts PLY
+headers and does not check ASCII STL (:mod:`.stl` welds STL corners as meshio does). Writers
+are deterministic (no timestamps) and atomic (temporary file in the target folder, then
+rename), so a failed run never leaves a partial file behind.
 """
-import io
 import os
-import struct
-import tempfile
-import warnings
-from contextlib import contextmanager, redirect_stderr, redirect_stdout
 
 import numpy as np
 
 from ...runtime.commit import atomic_write
 from ...runtime.errors import InputError, OutputError
 from ...runtime.limits import MAX_COORDINATE, check_read
-from ..input_files import open_input
 from .mesh import Mesh
 from .normals import recompute_normals
 from .obj import format_obj, read_obj
 from .off import format_off, read_off
-from .ply import format_ply, format_stl, mesh_from_meshio, per_vertex
+from .ply import format_ply, per_vertex
 from .ply_read import read_ply
+from .stl import format_stl, read_stl
 
 READ_FORMATS = (".obj", ".off", ".ply", ".stl")
 WRITE_FORMATS = (".obj", ".off", ".ply", ".stl")
@@ -56,7 +52,7 @@ def read_mesh(path: str | os.PathLike) -> Mesh:
         elif suffix == ".ply":
             mesh = read_ply(path)
         else:
-            mesh = _read_meshio(path, suffix)
+            mesh = read_stl(path)
     except InputError:
         raise
     except (OSError, UnicodeDecodeError) as exc:
@@ -64,41 +60,6 @@ def read_mesh(path: str | os.PathLike) -> Mesh:
             from None
     _validate(mesh, path)
     return mesh
-
-
-def _read_meshio(path, suffix):
-    import meshio  # only STL needs it; loading it costs a tenth of a second
-
-    failures = (SystemExit, meshio.ReadError, ValueError, IndexError, KeyError, EOFError,
-                TypeError, struct.error)
-    chatter = io.StringIO()
-    try:
-        # meshio prints its own message and calls sys.exit() on some files it cannot read
-        with warnings.catch_warnings(), redirect_stdout(chatter), redirect_stderr(chatter), \
-                _without_bom(path) as plain:
-            warnings.simplefilter("ignore")
-            m = meshio.read(plain, file_format="stl")
-    except failures as exc:
-        detail = str(exc) if not isinstance(exc, SystemExit) else "unrecognized content"
-        raise InputError(f"{path}: not a readable {suffix[1:].upper()} file ({detail})") from None
-    return mesh_from_meshio(m)
-
-
-@contextmanager
-def _without_bom(path):
-    """``path``, or a temporary copy without its leading byte order mark (meshio reads STL
-    only from a path, and would take an ASCII file with a mark for a binary one)."""
-    with open_input(path, "rb") as fh:
-        skipped = fh.tell() > 0
-        data = fh.read() if skipped else None
-    if not skipped:
-        yield path
-        return
-    with tempfile.TemporaryDirectory(prefix="srarap-stl-") as folder:
-        plain = os.path.join(folder, "mesh.stl")
-        with open(plain, "wb") as out:
-            out.write(data)
-        yield plain
 
 
 def _validate(mesh, path):

@@ -1,26 +1,12 @@
-"""PLY writer (the reader is :mod:`.ply_read`) and STL through meshio.
+"""PLY writer (the reader is :mod:`.ply_read`).
 
 meshio stamps the current time into PLY headers it writes; this writer does not, so the
 same mesh always gives the same bytes.
 """
 import numpy as np
 
-from .mesh import Mesh
-
 _PLY_TYPES = {"u1": "uchar", "i1": "char", "u2": "ushort", "i2": "short", "u4": "uint",
               "i4": "int", "f4": "float", "f8": "double"}
-
-
-def mesh_from_meshio(m):
-    """Convert a ``meshio.Mesh`` read from an STL file to :class:`Mesh` (triangles only)."""
-    blocks = [c.data for c in m.cells if c.type in ("triangle", "quad", "polygon")]
-    sizes = np.concatenate([np.full(len(b), b.shape[1]) for b in blocks]) if blocks else []
-    corners = np.concatenate([b.ravel() for b in blocks]) if blocks else []
-    points = np.asarray(m.points, dtype=float)
-    if points.ndim != 2 or points.shape[1] < 3:  # an empty or facet-less file
-        points = np.zeros((0, 3))
-    return Mesh(vertices=points[:, :3], face_sizes=np.asarray(sizes, dtype=np.int64),
-                face_vertices=np.asarray(corners, dtype=np.int64))
 
 
 def per_vertex(mesh, values, refs):
@@ -74,19 +60,6 @@ def _ascii_rows(table, mesh):
     faces = np.split(mesh.face_vertices, mesh.face_offsets[1:-1])
     rows += [" ".join(map(str, [len(f), *f.tolist()])) for f in faces]
     return ("\n".join(rows) + "\n").encode("ascii")
-
-
-def format_stl(mesh):
-    """Binary STL bytes of the mesh's triangles (polygons fanned), deterministic header."""
-    F = mesh.triangles()[0]
-    tri = mesh.vertices[F]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    length = np.linalg.norm(normal, axis=1, keepdims=True)
-    normal = np.divide(normal, length, out=np.zeros_like(normal), where=length > 0)
-    record = np.zeros(len(F), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
-    record["n"], record["v"] = normal, tri
-    header = b"binary STL written by srarap".ljust(80, b" ")
-    return header + np.uint32(len(F)).tobytes() + record.tobytes()
 
 
 def _face_bytes(mesh):
