@@ -66,3 +66,22 @@ def test_every_coarse_triangle_faces_the_way_the_surface_does(seed):
     centroid = V[G].mean(axis=1)
     assert np.all(np.einsum("ij,ij->i", normals(V, G), centroid) > 0)  # outward, like F
     assert topology_summary(G, len(V)) == topology_summary(F, len(V))
+
+
+def soup(V, F):
+    """Every face with vertices of its own (what a loader that splits at seams gives)."""
+    return V[F.ravel()], np.arange(F.size).reshape(-1, 3)
+
+
+def test_no_part_of_the_surface_vanishes_whole():
+    """A lone triangle passes the link condition, but collapsing one of its edges would delete
+    it and leave its other vertices in no face: such parts stay, and the rest simplifies."""
+    V, F = grid(12)
+    lone = np.array([[5.0, 0, 0], [6, 0, 0], [5, 1, 0]])
+    V2 = np.vstack([V, lone])
+    F2 = np.vstack([F, len(V) + np.array([[0, 1, 2]])])
+    G = collapse_to(V2, F2, 30, np.zeros(len(V2), bool))
+    assert [len(V), len(V) + 1, len(V) + 2] in G.tolist()
+    assert np.unique(G[G.max(axis=1) < len(V)]).size <= 30
+    Vs, Fs = soup(V, F)
+    assert np.array_equal(collapse_to(Vs, Fs, 30, np.zeros(len(Vs), bool)), Fs)

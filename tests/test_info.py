@@ -115,3 +115,21 @@ def test_the_shipped_configs_are_described(name):
     assert [(g["name"], g["vertices"]) for g in d["groups"]] == \
         [(g, len(ids)) for g, ids in c.groups.items()]
     assert d["constrained"] == len(c.ids) and d["constrained"] + d["free"] == d["vertices"]
+
+
+def test_a_surface_cut_open_at_coincident_vertices_is_named():
+    """Give the faces on one side of the tube's x = max line their own copies of its
+    vertices: exactly those copies sit on other vertices; the welded tube has none."""
+    from helpers import tube
+
+    from srarap_cli.solver.mesh_checks import mesh_warnings
+    V, F = tube()
+    assert not any("sit exactly" in w for w in mesh_warnings(V, F))
+    seam = np.flatnonzero(np.isclose(np.arctan2(V[:, 1], V[:, 0]), 0) & (np.hypot(V[:, 0], V[:, 1]) > 0.5))
+    side = (V[F].mean(axis=1)[:, 1] > 0)  # faces on the +y side of the seam
+    copy = np.arange(len(V))
+    copy[seam] = len(V) + np.arange(seam.size)
+    F2 = np.where(side[:, None], copy[F], F)
+    V2 = np.vstack([V, V[seam]])
+    [line] = [w for w in mesh_warnings(V2, F2) if "sit exactly" in w]
+    assert line.startswith(f"{seam.size} vertices sit exactly on another vertex ({seam.size} positions)")

@@ -302,3 +302,23 @@ def test_the_summary_counts_what_the_log_holds_and_reports_wall_seconds(tmp_path
                                   str(tmp_path / "a.obj")])
     assert (f"converged in {result.iterations} full-resolution iterations "
             f"(+ {result.coarse_iterations} coarse)") in r.stderr
+
+
+def test_a_mesh_that_does_not_simplify_is_solved_directly_with_a_warning():
+    """A triangle soup cannot be simplified: multires must say so and give the direct solve."""
+    from helpers import ends, twist
+
+    from srarap_cli.solver.deformer import Deformer
+    from srarap_cli.solver.oneshot import make_deformer
+    V, F = tube()
+    ids = ends(V)
+    targets = twist(V, ids, 6.0, 60)
+    Vs, Fs = V[F.ravel()], np.arange(F.size).reshape(-1, 3)
+    held = np.flatnonzero(np.isin(F.ravel(), ids))
+    moved = targets[np.searchsorted(ids, F.ravel()[held])]
+    multi = make_deformer(Vs, Fs, held, multires=20)
+    assert type(multi) is Deformer
+    assert any("simplifies only to" in w for w in multi.warnings)
+    direct = make_deformer(Vs, Fs, held, multires="off")
+    assert np.array_equal(multi.solve(moved, tol=1e-8).positions,
+                          direct.solve(moved, tol=1e-8).positions)

@@ -15,8 +15,9 @@ SUBFOLDERS = ("sample_meshes", "configs", "golden")
 @click.command("samples")
 @click.argument("folder")
 @click.option("--force", is_flag=True, help="Replace files of the same names in FOLDER.")
+@click.option("-q", "--quiet", is_flag=True, help="No summary line.")
 @guarded
-def samples(folder, force):
+def samples(folder, force, quiet):
     """Copy the sample meshes, handle files and goldens into FOLDER (three subfolders).
 
     Then, for example: srarap deform FOLDER/sample_meshes/bar.obj FOLDER/configs/bar-twist.yaml
@@ -37,4 +38,5 @@ def samples(folder, force):
         except OSError as exc:
             raise OutputError(f"{folder}: cannot create folder: {exc.strerror}") from None
     commit_files(files)
-    click.echo(f"srarap samples: wrote {len(files)} files to {folder}", err=True)
+    if not quiet:
+        click.echo(f"srarap samples: wrote {len(files)} files to {folder}", err=True)

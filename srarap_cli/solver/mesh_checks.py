@@ -68,8 +68,9 @@ def edge_counts(F):
 
 
 def mesh_warnings(V, F):
-    """Warning lines for duplicate faces, collapsed, zero-area and needle triangles, and
-    non-manifold edges and vertices of a triangle mesh (V (n, 3), F (f, 3)).
+    """Warning lines for duplicate faces, collapsed, zero-area and needle triangles,
+    non-manifold edges and vertices, and surfaces cut open at coincident vertices, of a
+    triangle mesh (V (n, 3), F (f, 3)).
 
     Examples
     --------
@@ -98,7 +99,26 @@ def mesh_warnings(V, F):
         out.append(f"{needles} needle faces (an angle under {NEEDLE_DEGREES:g} degree); "
                    "cotangents are capped at 1000 so no edge weight can swamp the others")
     out.extend(_manifold_warnings(distinct, len(V)))  # duplicates said above
+    out.extend(_unwelded_warnings(V, F))
     return out
+
+
+def _unwelded_warnings(V, F):
+    """Border vertices that sit exactly on another border vertex: the surface is cut open
+    there (each side deforms on its own), typically a triangle soup or a file split at
+    texture seams by the program that loaded it. Only border vertices can be such cuts, so
+    a closed mesh costs one pass over its edges."""
+    edges, counts = edge_counts(F)
+    border = np.unique(edges[counts == 1])
+    if border.size < 2:
+        return []
+    _, first, count = np.unique(V[border], axis=0, return_index=True, return_counts=True)
+    extra = int(border.size - first.size)
+    if not extra:
+        return []
+    return [f"{extra} vertices sit exactly on another vertex ({int((count > 1).sum())} "
+            "positions): the faces there share no vertex, so the surface is cut open; weld "
+            "coincident vertices first (trimesh: merge_vertices(merge_tex=True, merge_norm=True))"]
 
 
 def _manifold_warnings(F, n):

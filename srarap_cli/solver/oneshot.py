@@ -33,7 +33,7 @@ def make_deformer(V, F, constrained, labels=None, *, area=None, cache=None, **op
             deformer.warnings.append(f"multires {setting} is not below the mesh's "
                                      f"{len(V)} vertices: solved directly")
         return deformer
-    return MultiresDeformer(V, F, constrained, labels, size=size, cache=cache, area=area,
+    return MultiresDeformer.or_direct(V, F, constrained, labels, size=size, cache=cache, area=area,
                             mode=settings.multires_mode,
                             **setup)
 

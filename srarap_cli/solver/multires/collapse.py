@@ -108,7 +108,8 @@ def _round(V, lifted, surface, F, Q, frozen, banned, need):
     rings = _Rings(edges, F, n)
     win = _independent(rings, u, v, n)
     u, v, c = u[win], v[win], c[win]
-    good = rings.link_ok(u, v, c) & _keeps_shape(V, surface, rings, u, v)
+    good = (rings.link_ok(u, v, c) & rings.keeps_a_face(u, c)
+            & _keeps_shape(V, surface, rings, u, v))
     invalid = u[~good] * n + v[~good]
     u, v = u[good][:need], v[good][:need]
     return u, v, invalid
@@ -229,6 +230,11 @@ class _Rings:
     def star(self, u):
         """(owner, face) pairs: the triangles around u[owner]."""
         return _segments(self.face_ptr, self.face, u)
+
+    def keeps_a_face(self, u, c):
+        """u has a triangle besides the c it shares with v: a lone triangle or a fan that
+        would vanish whole (leaving its other vertices in no face) does not collapse."""
+        return self.face_ptr[u + 1] - self.face_ptr[u] > c
 
     def link_ok(self, u, v, c):
         """Link condition: u and v share exactly the neighbours opposite their edge (two

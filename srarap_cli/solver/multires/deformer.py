@@ -29,6 +29,9 @@ STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
                "fine_solve": "fine solve", "fine_start": "full-resolution start",
                "fine_iterations": "full-resolution iterations"}
 MODES = ("refine", "transfer")
+#: a coarse mesh keeping more than this fraction of the vertices gains nothing over a
+#: full-resolution solve
+NO_GAIN = 0.5
 
 
 @dataclass
@@ -149,6 +152,9 @@ class MultiresDeformer:
         self.stages = {"simplify": time.perf_counter() - start}
         self.fine, fine_setup = fine()
         self.area = self.fine.area
+        self.direct = self._no_gain()
+        if self.direct is not None:
+            return
         self._build_coarse(cache, options)
         mark = time.perf_counter()
         if mode == "refine":
@@ -158,6 +164,23 @@ class MultiresDeformer:
         self.stages["factor"] = fine_setup + time.perf_counter() - mark
         self.warnings = (self.fine.warnings + notes
                          + [f"multires: {w}" for w in self.coarse.warnings])
+
+    def _no_gain(self):
+        """The full-resolution Deformer when the simplification kept more than half the
+        vertices (a triangle soup, a mesh of tiny parts): a coarse level would cost about
+        as much as the mesh itself. None otherwise."""
+        kept, used = self.coarse.vertices.size, np.unique(self.F).size
+        if kept <= NO_GAIN * used:
+            return None
+        self.fine.warnings.append(f"multires: the mesh simplifies only to {kept} of its {used} "
+                                  "vertices; solved at full resolution")
+        return self.fine
+
+    @classmethod
+    def or_direct(cls, *args, **kwargs):
+        """A MultiresDeformer, or the plain Deformer it found to be no slower."""
+        built = cls(*args, **kwargs)
+        return built if built.direct is None else built.direct
 
     def _fine_setup(self, area, options):
         """The full-resolution Deformer (factored in refine mode) and its seconds."""
@@ -187,8 +210,8 @@ class MultiresDeformer:
         if size is None:
             self.coarse_deformer = Deformer(*args, area=self.area, labels=labels, **options)
         else:  # a level between: coarse-to-fine and corrections from a coarser mesh again
-            self.coarse_deformer = MultiresDeformer(*args, labels, size=size, cache=cache,
-                                                    area=self.area, **options)
+            self.coarse_deformer = MultiresDeformer.or_direct(
+                *args, labels, size=size, cache=cache, area=self.area, **options)
         self.stages["coarse_precompute"] = time.perf_counter() - start
 
     def _build_transfer(self):
