@@ -1,9 +1,12 @@
 """Checks at the Python API's boundary: a wrong argument is a ValueError that names it and the
 expected shape, not a numpy broadcast error or a NumericalError deep inside a solve."""
+from typing import Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 
-def mesh_arrays(V, F):
+def mesh_arrays(V: ArrayLike, F: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """``V`` as an (n, 3) finite float array and ``F`` as an (f, 3) int array indexing it.
 
     Examples
@@ -31,7 +34,7 @@ def mesh_arrays(V, F):
     return V, F
 
 
-def vertex_ids(ids, n, name="constrained"):
+def vertex_ids(ids: ArrayLike, n: int, name: str = "constrained") -> np.ndarray:
     """``ids`` as a (k,) int array of distinct vertex indices below ``n``."""
     ids = np.asarray(ids)
     if ids.dtype.kind not in "iu" or ids.ndim > 1:
@@ -44,7 +47,7 @@ def vertex_ids(ids, n, name="constrained"):
     return ids
 
 
-def targets(values, k):
+def targets(values: ArrayLike, k: int) -> np.ndarray:
     """``values`` as a (k, 3) finite float array, one row per constrained vertex."""
     values = _floats(values, "targets")
     if values.shape != (k, 3):
@@ -62,7 +65,7 @@ def _floats(values, name):
         raise ValueError(f"{name} must be an array of numbers") from None
 
 
-def mesh_like(mesh, name="mesh"):
+def mesh_like(mesh: Any, name: str = "mesh") -> tuple[np.ndarray, Any]:
     """``(V, F)`` arrays of whatever the ecosystem calls a mesh, without importing its package.
 
     Accepts a ``(V, F)`` pair, srarap's :class:`~srarap_cli.io.mesh.Mesh`, a

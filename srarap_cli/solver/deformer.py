@@ -8,6 +8,7 @@ matrix and the local step.
 """
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -43,12 +44,11 @@ class DeformResult:
     iterations : int, local/global iterations run at full resolution
     coarse_iterations : int, iterations on coarse meshes (multiresolution; 0 here)
     coarse_log : bool (class attribute), the log follows another mesh than the result
-    approximate : bool (class attribute), the result is the paper's transfer of a coarse
-        solve, not iterated at full resolution
+    approximate : bool (property), the result is the paper's transfer of a coarse solve, not
+        iterated at full resolution
     """
 
     coarse_log = False
-    approximate = False
     coarse_iterations = 0
     positions: np.ndarray
     rotors: np.ndarray
@@ -66,19 +66,23 @@ class DeformResult:
             raise ValueError("this result carries no faces: pair positions with your F")
         return self.positions, self.faces
 
-    def to_trimesh(self):
+    def to_trimesh(self) -> Any:
         """A ``trimesh.Trimesh`` of the deformed shape (needs trimesh installed)."""
         import trimesh
 
         V, F = self.to_arrays()
         return trimesh.Trimesh(vertices=V, faces=F, process=False)
 
-    def to_meshio(self):
+    def to_meshio(self) -> Any:
         """A ``meshio.Mesh`` of the deformed shape (needs meshio installed)."""
         import meshio
 
         V, F = self.to_arrays()
         return meshio.Mesh(V, [("triangle", F)])
+
+    @property
+    def approximate(self) -> bool:
+        return False
 
     def energies(self) -> dict[str, float]:
         """``membrane``, ``bending`` and ``total`` energy of the returned shape."""
@@ -93,7 +97,7 @@ class DeformResult:
         """Wall time of the solve."""
         return self.log[-1]["seconds"]
 
-    def report_lines(self):
+    def report_lines(self) -> list[str]:
         """Extra lines a command prints about how the result was obtained (none here)."""
         return []
 
@@ -197,11 +201,12 @@ class Deformer:
         self.energy_scale = max(float(self.graph.c @ self.edges.q_sq), 1e-300)
         self.diagonal = float(np.linalg.norm(np.ptp(self.V, axis=0)))
         self._bending_alpha = self.alpha if METHODS[method].bending else 0.0
-        self._poisson = self._local_step = None
+        self._poisson: PoissonSolver | None = None
+        self._local_step: Any = None
         if prepare:
             self.prepare()
 
-    def prepare(self):
+    def prepare(self) -> "Deformer":
         """Factor the Poisson matrix and build the local step, if not done yet."""
         if self._poisson is None:
             self._poisson = PoissonSolver(self.graph, self._mask)
@@ -222,41 +227,41 @@ class Deformer:
         return held
 
     @property
-    def poisson(self):
+    def poisson(self) -> Any:
         """The factored Poisson matrix (global step)."""
         return self.prepare()._poisson
 
     @property
-    def local_step(self):
+    def local_step(self) -> Any:
         """The method's local step (see :mod:`srarap_cli.solver.local_step`)."""
         return self.prepare()._local_step
 
-    def fixed_targets(self, targets):
+    def fixed_targets(self, targets: np.ndarray) -> np.ndarray:
         """Positions (j, 3) of every held vertex (``fixed``): ``targets`` for the constrained
         ones, rest positions for the rest."""
         full = self.V[self.fixed].copy()
         full[self.constrained_slots] = targets
         return full
 
-    def bending(self, R):
+    def bending(self, R: np.ndarray) -> float:
         """The bending energy of rotors ``R`` (n, 4) (0 for classic ARAP)."""
         return bending_energy(self.graph, R, self._bending_alpha, self.area)
 
-    def energy(self, P, R):
+    def energy(self, P: np.ndarray, R: np.ndarray) -> dict[str, float]:
         """Energy terms of any positions ``P`` (n, 3) with rotors ``R`` (n, 4), from per-edge
         residuals (accurate near rigid motions): dict ``membrane``, ``bending``, ``total``."""
         membrane = membrane_energy(self.graph, self.edges.q, P, R)
         bending = self.bending(R)
         return {"membrane": membrane, "bending": bending, "total": membrane + bending}
 
-    def best_rotors(self, P, R_prev):
+    def best_rotors(self, P: np.ndarray, R_prev: np.ndarray) -> np.ndarray:
         """One local step: the rotors (n, 4) the method gives positions ``P`` (n, 3), with
         ``R_prev`` as the previous rotors (feedback, hemispheres)."""
         return self.local_step.step(self.edges.cross(P),
                                     self.edges.stretch(P) if self.local_step.needs_stretch
                                     else None, R_prev)
 
-    def step_for(self, targets, tol=DEFAULTS["tol"]):
+    def step_for(self, targets: ArrayLike, tol: float = DEFAULTS["tol"]) -> "LocalGlobalStep":
         """The :class:`~srarap_cli.solver.step.LocalGlobalStep` of one set of targets."""
         return LocalGlobalStep(self, targets, tol)
 
@@ -308,7 +313,7 @@ class Deformer:
                             monitor.iterations)
 
 
-def unanchored(graph, constrained):
+def unanchored(graph: Any, constrained: np.ndarray) -> tuple[np.ndarray, list[str]]:
     """Vertices nothing can move: unreferenced ones and every connected part without a
     constrained vertex. Returns their sorted ids and a warning per kind found.
 
@@ -335,7 +340,7 @@ def unanchored(graph, constrained):
     return np.union1d(lonely, floating), notes
 
 
-def weight_warnings(graph):
+def weight_warnings(graph: Any) -> list[str]:
     """Warnings about edge weights that can keep a solve from settling."""
     out = []
     if graph.degenerate:

@@ -10,7 +10,9 @@ from .multires import MultiresDeformer, coarse_size
 from .settings import DEFAULT_SETTINGS, check_keywords
 
 
-def make_deformer(V, F, constrained, labels=None, *, area=None, cache=None, **options):
+def make_deformer(V: ArrayLike, F: ArrayLike, constrained: ArrayLike,
+                  labels: ArrayLike | None = None, *, area: float | None = None,
+                  cache: str | None = None, **options: Any) -> Deformer | MultiresDeformer:
     """The solver for the settings ``options``: a :class:`Deformer`, or a
     :class:`MultiresDeformer` when ``multires`` asks for one.
 
@@ -26,12 +28,12 @@ def make_deformer(V, F, constrained, labels=None, *, area=None, cache=None, **op
     settings = DEFAULT_SETTINGS.replace(**options)
     setup = settings.stage("setup")
     setting = settings.multires
-    size = coarse_size(setting, len(V))
+    size = coarse_size(setting, np.shape(V)[0])
     if size is None:
         deformer = Deformer(V, F, constrained, area=area, labels=labels, **setup)
         if setting not in (None, "auto", "off"):
             deformer.warnings.append(f"multires {setting} is not below the mesh's "
-                                     f"{len(V)} vertices: solved directly")
+                                     f"{np.shape(V)[0]} vertices: solved directly")
         return deformer
     return MultiresDeformer.or_direct(V, F, constrained, labels, size=size, cache=cache, area=area,
                             mode=settings.multires_mode,

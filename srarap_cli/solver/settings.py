@@ -8,6 +8,7 @@ The handle file's ``solver`` section, a batch manifest's ``settings``, the comma
 and constraint set), ``solve`` to each ``solve`` call, ``build`` chooses the solver itself.
 """
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -42,17 +43,17 @@ class Setting:
     default: object
     help: str
     stage: str
-    minimum: float = None
+    minimum: float | None = None
     strict: bool = False
     choices: tuple = ()
-    method: str = None
-    metavar: str = None
+    method: str | None = None
+    metavar: str | None = None
 
     @property
-    def flag(self):
+    def flag(self) -> str:
         return "--" + self.name.replace("_", "-")
 
-    def parse(self, value, error):
+    def parse(self, value: Any, error: Callable[[str], Exception]) -> Any:
         """``value`` checked and converted; ``error(message)`` makes the exception to raise."""
         if self.kind == "choice":
             if value not in self.choices:
@@ -63,6 +64,7 @@ class Setting:
                 return parse_size(value)
             except ValueError as exc:
                 raise error(f"{self.name} {exc}") from None
+        out: float
         if self.kind == "int":
             if isinstance(value, bool) or not isinstance(value, int):
                 raise error(f"{self.name} must be an integer")
@@ -172,7 +174,7 @@ class Settings:
         """Every setting by name (JSON-serializable: fingerprints hash it)."""
         return {name: getattr(self, name) for name in NAMES}
 
-    def replace(self, **changes) -> "Settings":
+    def replace(self, **changes: Any) -> "Settings":
         """A copy with ``changes`` (validated; None keeps the current value)."""
         check_keywords(changes, ("setup", "solve", "build"), "Settings.replace")
         return Settings(**{**self.as_dict(),
@@ -192,7 +194,7 @@ def resolve(file_settings: dict, overrides: dict) -> Settings:
 DEFAULT_SETTINGS = Settings(**DEFAULTS)
 
 
-def parse_mapping(spec, name, error):
+def parse_mapping(spec: Any, name: str, error: Callable[[str], Exception]) -> dict[str, Any]:
     """Validated settings from the mapping ``name`` (a handle file's ``solver``, a manifest's
     ``settings``); ``error(message)`` makes the exception raised for a bad key or value."""
     if not isinstance(spec, dict):
@@ -204,7 +206,7 @@ def parse_mapping(spec, name, error):
     return {name: BY_NAME[name].parse(value, error) for name, value in spec.items()}
 
 
-def check_keywords(options, allowed_stages, where):
+def check_keywords(options: dict[str, Any], allowed_stages: tuple[str, ...], where: str) -> None:
     """Raise TypeError naming the first keyword of ``options`` that is not a setting taken
     at one of ``allowed_stages``."""
     for name in options:
@@ -214,7 +216,7 @@ def check_keywords(options, allowed_stages, where):
                             f"(solver settings: {', '.join(allowed)})")
 
 
-def complete(result, opts):
+def complete(result: Any, opts: "Settings") -> bool:
     """Whether a solve ended as asked: converged; or ``tol`` 0 (no stopping test: run exactly
     ``max_iter`` iterations) with every iteration run; or the approximate mode (transfer),
     whose coarse solve converged (the full-resolution shape is never iterated there)."""

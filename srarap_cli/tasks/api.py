@@ -1,6 +1,9 @@
 """The one-shot function of the Python API: any mesh, any handles, one deformation."""
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
+
+import numpy as np
 
 from ..io.handles import as_constraints
 from ..io.mesh.mesh import Mesh
@@ -11,8 +14,10 @@ from ..solver.settings import check_keywords
 from .pipeline import deform_mesh
 
 
-def deform(mesh: Any, handles: Any, *arrays: Any, callback=None, cache: str | None = None,
-           initial=None, **settings: Any) -> DeformResult:
+def deform(mesh: Any, handles: Any, *arrays: Any,
+           callback: Callable[[dict], None] | None = None, cache: str | None = None,
+           initial: tuple[np.ndarray, np.ndarray] | None = None,
+           **settings: Any) -> DeformResult:
     """Deform a mesh by its handles, in one call.
 
     Parameters

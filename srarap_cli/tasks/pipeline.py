@@ -38,9 +38,9 @@ class Problem:
     targets: np.ndarray
     labels: np.ndarray
     area: float | None = None
-    sub: object = None
+    sub: Any = None
 
-    def targets_for(self, constraint_targets):
+    def targets_for(self, constraint_targets: np.ndarray) -> np.ndarray:
         """Solve targets for a new set of constraint targets (same constrained vertices)."""
         if self.sub is None:
             return constraint_targets
@@ -49,7 +49,7 @@ class Problem:
         return out
 
 
-def problem(mesh, constraints, name="mesh"):
+def problem(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> Problem:
     """Triangulate ``mesh`` (faces that repeat a vertex left out) and cut it down to the
     region of interest, if there is one. ``name`` (the mesh's file) starts error messages.
 
@@ -82,14 +82,15 @@ def _labels(constraints, full_ids):
     return np.unique(labels, return_inverse=True)[1].ravel()
 
 
-def build_deformer(p, opts, cache=None):
+def build_deformer(p: Problem, opts: Settings, cache: str | None = None) -> Any:
     """The solver of a :class:`Problem` with resolved settings ``opts`` (see
     :func:`~srarap_cli.solver.oneshot.make_deformer`; ``cache``: folder for coarse meshes)."""
     return make_deformer(p.V, p.F, p.ids, p.labels, area=p.area, cache=cache,
                          **opts.stage("setup", "build"))
 
 
-def scatter(mesh, p, positions, constraints, constraint_targets=None):
+def scatter(mesh: Mesh, p: Problem, positions: np.ndarray, constraints: Constraints,
+            constraint_targets: np.ndarray | None = None) -> np.ndarray:
     """Full-mesh positions from a problem's solved positions. Constrained vertices go to their
     targets even where a region of interest left them out of the solve (handle vertices
     whose triangles touch no movable vertex)."""

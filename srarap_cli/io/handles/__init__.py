@@ -6,6 +6,7 @@ problem as one line naming the file, group and field.
 """
 import os
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -49,11 +50,11 @@ class Constraints:
     tracks: list = field(default_factory=list)
 
     @property
-    def last_key_frame(self):
+    def last_key_frame(self) -> float:
         """Frame of the latest keyframe (0 without keyframes)."""
         return max((float(t.frames[-1]) for _, _, t in self.tracks), default=0.0)
 
-    def targets_at(self, frame):
+    def targets_at(self, frame: float) -> np.ndarray:
         """Targets (k, 3) at ``frame``: keyframed groups moved, the others as they are."""
         out = self.targets.copy()
         for slots, rest, track in self.tracks:
@@ -61,7 +62,7 @@ class Constraints:
         return out
 
 
-def as_constraints(handles, V: np.ndarray) -> "Constraints":
+def as_constraints(handles: Any, V: np.ndarray) -> "Constraints":
     """Constraints from what a Python caller has: a handle file's path, a dict in the handle
     file's schema, an ``(ids, targets)`` pair, or Constraints. Raises TypeError naming
     ``handles`` for anything else, ValueError for a wrong pair.
@@ -122,7 +123,8 @@ def _load_document(path):
     return load_document(path, "json" if ext == ".json" else "yaml")
 
 
-def parse_handles(doc, V, path="<handles>", base=".", fps=None):
+def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = ".",
+                  fps: float | None = None) -> "Constraints":
     """Validate an already-loaded handle document (dict) against ``V``; see :func:`load_handles`."""
     ctx = Context(path)
     doc = ctx.mapping(doc, "the handle file", TOP_KEYS)
@@ -208,7 +210,7 @@ def _from_sel(path, V):
     return Constraints(ids=ids, targets=t[ids], groups={"fixed": fixed, "handle": handle})
 
 
-def referenced_files(handles):
+def referenced_files(handles: str | os.PathLike) -> list[str]:
     """Files a handle file names (``.dmat``, ``.sel``, ``.def``, ...): every string in it that
     is the path of an existing file, relative to the handle file; a ``.sel`` brings its ``.def``."""
     handles = str(handles)

@@ -80,10 +80,10 @@ def _validate(mesh, path):
                          f"but the mesh has vertices 0..{n - 1}")
 
 
-def format_mesh(mesh, suffix, ascii=False):
+def format_mesh(mesh: Mesh, suffix: str, ascii: bool = False) -> tuple[bytes, list[str]]:
     """File content for ``mesh`` in the format of ``suffix`` (PLY in ASCII with ``ascii``),
     with warnings for lost data."""
-    lost = []
+    lost: list[str] = []
     if suffix == ".obj":
         return format_obj(mesh).encode("utf-8"), lost
     if suffix == ".stl":

@@ -1,7 +1,9 @@
 """The polygon mesh record every reader fills and every writer consumes."""
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 
 @dataclass
@@ -33,7 +35,7 @@ class Mesh:
     statements: list = field(default_factory=list)
 
     @classmethod
-    def from_arrays(cls, V, F) -> "Mesh":
+    def from_arrays(cls, V: ArrayLike, F: np.ndarray | Sequence[ArrayLike]) -> "Mesh":
         """A mesh of positions ``V`` (n, 3) and faces ``F``: an (f, k) int array of k-gons,
         or a list of vertex-id sequences of any sizes.
 
@@ -59,11 +61,11 @@ class Mesh:
                    face_vertices=corners.astype(np.int64))
 
     @property
-    def face_offsets(self):
+    def face_offsets(self) -> np.ndarray:
         """(k + 1,) cumulative corner offsets: polygon f is ``face_vertices[o[f]:o[f+1]]``."""
         return np.concatenate([[0], np.cumsum(self.face_sizes)]).astype(np.int64)
 
-    def triangles(self):
+    def triangles(self) -> tuple[np.ndarray, np.ndarray]:
         """Fan triangulation for the solve: ``F`` (f, 3) and the polygon of each triangle."""
         if self.face_sizes.size and self.face_sizes.min() == self.face_sizes.max() == 3:
             return self.face_vertices.reshape(-1, 3), np.arange(self.face_sizes.size)
@@ -72,7 +74,7 @@ class Mesh:
         F, J = igl.polygons_to_triangles(self.face_vertices.astype(np.int64), self.face_offsets)
         return F, J
 
-    def with_vertices(self, vertices):
+    def with_vertices(self, vertices: ArrayLike) -> "Mesh":
         """A copy with new positions and normals recomputed for them."""
         from .normals import recompute_normals
         out = Mesh(**{k: getattr(self, k) for k in self.__dataclass_fields__})

@@ -7,6 +7,8 @@ ASCII grammar is checked (a truncated or misspelt facet is an error naming it) a
 is vectorized (no Python loop per number). Taking STL out of meshio also keeps meshio and
 its terminal-rendering dependencies out of the default install.
 """
+import os
+
 import numpy as np
 
 from ...runtime.errors import InputError
@@ -21,7 +23,7 @@ _FACET = [b"facet", b"normal", None, None, None, b"outer", b"loop",
 _CORNERS = [8, 9, 10, 12, 13, 14, 16, 17, 18]
 
 
-def read_stl(path) -> Mesh:
+def read_stl(path: str | os.PathLike) -> Mesh:
     """Read a binary or ASCII STL file.
 
     A file whose size is exactly 84 + 50 x (its triangle count) is binary, whatever its

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, ClassVar, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 if TYPE_CHECKING:
     import numpy as np
@@ -28,6 +28,9 @@ class LocalStep(Protocol):
 
     bending: ClassVar[bool]
     needs_stretch: ClassVar[bool]
+
+    def __init__(self, edges: Any, constrained: np.ndarray, alpha_area: float,
+                 feedback: float, **options: Any) -> None: ...
 
     def step(self, S: np.ndarray, s: np.ndarray | None, R_prev: np.ndarray,
              forcing: float = 0.0) -> np.ndarray:

@@ -2,10 +2,13 @@
 the result to the full mesh the paper's way (rotors spread harmonically, one Poisson solve) or
 start full-resolution iterations from it (coarse-to-fine)."""
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import partial
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ...runtime.errors import NumericalError
 from ...runtime.threads import background, single_threaded
@@ -64,18 +67,18 @@ class MultiresResult(DeformResult):
     start_energy: dict = field(default_factory=dict)
     wall: float = 0.0
 
-    def energies(self):
+    def energies(self) -> dict[str, float]:
         return dict(self.full_energy)
 
     @property
-    def approximate(self):
+    def approximate(self) -> bool:
         return self.coarse_log
 
     @property
-    def seconds(self):
+    def seconds(self) -> float:
         return self.wall
 
-    def report_lines(self):
+    def report_lines(self) -> list[str]:
         """``srarap: multires: 5002 of 737986 vertices; simplify 1.20 s, ...``"""
         info = self.coarse
         cached = " (coarse mesh from cache)" if info["cache_hit"] else ""
@@ -177,7 +180,7 @@ class MultiresDeformer:
         return self.fine
 
     @classmethod
-    def or_direct(cls, *args, **kwargs):
+    def or_direct(cls, *args: Any, **kwargs: Any) -> "MultiresDeformer | Deformer":
         """A MultiresDeformer, or the plain Deformer it found to be no slower."""
         built = cls(*args, **kwargs)
         return built if built.direct is None else built.direct
@@ -192,7 +195,7 @@ class MultiresDeformer:
         return fine, time.perf_counter() - mark
 
     @property
-    def info(self):
+    def info(self) -> dict[str, Any]:
         """``vertices`` (coarse count), ``of`` (full count), ``cache_hit``."""
         return {"vertices": int(self.coarse.vertices.size), "of": len(self.V),
                 "cache_hit": self.cache_hit}
@@ -225,9 +228,11 @@ class MultiresDeformer:
         self.solver = DirichletSolver(self.fine.graph.laplacian, self._known)
 
     @single_threaded
-    def solve(self, targets, *, max_iter=DEFAULTS["max_iter"], tol=DEFAULTS["tol"],
-              time_limit=DEFAULTS["time_limit"], accel=DEFAULTS["accel"],
-              start=DEFAULTS["start"], initial=None, callback=None):
+    def solve(self, targets: ArrayLike, *, max_iter: int = DEFAULTS["max_iter"],
+              tol: float = DEFAULTS["tol"], time_limit: float | None = DEFAULTS["time_limit"],
+              accel: str = DEFAULTS["accel"], start: str = DEFAULTS["start"],
+              initial: tuple[np.ndarray, np.ndarray] | None = None,
+              callback: Callable[[dict], None] | None = None) -> "MultiresResult":
         """Deform toward ``targets``; see :meth:`Deformer.solve` (``max_iter`` and
         ``time_limit`` hold for each level). Returns a :class:`MultiresResult`."""
         begin = time.perf_counter()
@@ -278,7 +283,7 @@ class MultiresDeformer:
                               stages=stages, coarse=self.info, coarse_converged=True,
                               wall=time.perf_counter() - begin)
 
-    def coarse_correction(self, targets, tol=DEFAULTS["tol"]):
+    def coarse_correction(self, targets: np.ndarray, tol: float = DEFAULTS["tol"]) -> Any:
         """The :class:`~.correction.CoarseCorrection` of the full-resolution iterates for
         ``targets`` (k, 3) (refine mode)."""
         level, coarse_targets = self.coarse_deformer, targets[self._coarse_slots]
@@ -349,7 +354,7 @@ class MultiresDeformer:
         out[self._row[self.fine.auto_fixed]] = IDENTITY
         return out
 
-    def known_positions(self, targets, coarse_positions):
+    def known_positions(self, targets: np.ndarray, coarse_positions: np.ndarray) -> np.ndarray:
         """Positions (j, 3) of the transfer's Dirichlet vertices: targets for the
         constrained ones, the coarse solve's for coarse vertices, rest for the others."""
         out = self.V[self._known].copy()
