@@ -58,3 +58,46 @@ def test_nested_dissection_back_end_is_deterministic_across_processes():
     digests = {subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True,
                               text=True, check=True).stdout for _ in range(2)}
     assert len(digests) == 1 and len(next(iter(digests)).strip()) == 64
+
+
+def test_one_nested_dissection_serves_the_poisson_matrix_and_the_rotor_preconditioner(
+        monkeypatch):
+    """Their free vertices differ (the rotor system keeps a handle's interior), yet one METIS
+    run of the mesh graph, restricted to each matrix's rows, orders both."""
+    import pymetis
+
+    runs = []
+    real = pymetis.nested_dissection
+    monkeypatch.setattr(pymetis, "nested_dissection",
+                        lambda *a, **k: runs.append(1) or real(*a, **k))
+    monkeypatch.setattr(linalg, "LARGE", 0)
+    V, F = tube(length=6.0, rings=12, segments=8)
+    ids = ends(V, 6.0)
+    d = Deformer(V, F, ids)
+    assert len(runs) == 1
+    assert d.local_step.free.size != len(V) - ids.size  # two different row sets were ordered
+
+
+def test_restricted_order_is_the_mesh_order_of_the_rows():
+    V, F = tube(length=6.0, rings=12, segments=8)
+    graph = Deformer(V, F, ends(V, 6.0), prepare=False).graph
+    full = graph.fill_order()
+    assert np.array_equal(np.sort(full), np.arange(len(V)))
+    rows = np.arange(0, len(V), 3)
+    sub = graph.fill_order(rows)
+    assert np.array_equal(np.sort(sub), np.arange(rows.size))
+    rank = np.argsort(full)  # position of each vertex in the full order
+    assert np.all(np.diff(rank[rows[sub]]) > 0)
+
+
+def test_an_approximate_factor_is_single_precision_and_answers_in_double(monkeypatch):
+    rng = np.random.default_rng(3)
+    M = sp.random(40, 40, density=0.2, random_state=4)
+    A = (M @ M.T + sp.eye(40)).tocsr()
+    b = rng.standard_normal((40, 4))
+    monkeypatch.setattr(linalg, "LARGE", 0)
+    x = linalg.factor(A, symmetric=True, approximate=True)(b)
+    exact = linalg.factor(A, symmetric=True)(b)
+    assert x.dtype == np.float64
+    error = np.abs(x - exact).max() / np.abs(exact).max()
+    assert 1e-12 < error < 1e-5  # single precision: neither exact nor far off

@@ -30,7 +30,7 @@ class PoissonSolver:
         A = sp.csr_matrix((np.r_[-graph.c[inside], np.where(free, K.diagonal(), 1.0)],
                            (np.r_[graph.I[inside], ids], np.r_[graph.J[inside], ids])),
                           shape=K.shape)
-        self._solve = factor(A, symmetric=True)
+        self._solve = factor(A, symmetric=True, order=graph.fill_order)
         self._to_fixed = K[:, self.fixed].tocsr()
         self._free_column = free.astype(float)[:, None]
 

@@ -1,11 +1,13 @@
 """Edge weights, cell adjacency and the Laplacian of a triangle mesh."""
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
 
 from .group_rotations import label_sum
 from .libigl import igl
+from .linalg import fill_order
 from .settings import WEIGHT_KINDS
 
 # Half-cotangents are bounded: an angle under ~0.06 degrees (a needle) would otherwise give
@@ -50,6 +52,23 @@ class CellGraph:
     @property
     def n(self):
         return self.degree.shape[0]
+
+    @cached_property
+    def _nested_order(self):
+        return fill_order(self.laplacian)
+
+    def fill_order(self, rows=None):
+        """A fill-reducing order of the vertices ``rows`` (default all), as positions into
+        ``rows``: METIS's nested dissection of the whole mesh graph, run once per graph and
+        restricted to each matrix's vertices, so the Poisson matrix and the rotor
+        preconditioner (whose free vertices differ) share one run (3.4 s at 738k vertices).
+        Removing vertices keeps a nested dissection's separators separators."""
+        order = self._nested_order
+        if rows is None:
+            return order
+        rank = np.empty(self.n, dtype=np.int64)
+        rank[order] = np.arange(self.n)
+        return np.argsort(rank[rows], kind="stable")
 
     def edge_blocks(self, m=None):
         """Slices of at most :data:`EDGE_BLOCK` consecutive edges that cover the first ``m``

@@ -24,6 +24,8 @@ and the scalar matrix is factored again when those powers change (a pure functio
 current blocks, so solves stay reproducible). Ordinary deformations never reach the factor 8
 and keep the rest factorization; far handles take 4 to 6 CG iterations.
 """
+from functools import partial
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -61,13 +63,14 @@ class RotorSystem:
         self._fixed_rows = W[self.fixed]
         self._free_to_fixed = W[self.free][:, self.fixed].tocsr()
         self._coupling = _int32(W[self.free][:, self.free].tocsr())
+        self._order = partial(graph.fill_order, self.free)
         self._rest_diagonal = tau[self.free] + sigma[self.free] * edges.rest_scale[self.free]
         self._powers = np.zeros(self.free.size, dtype=np.int8)
         self._precondition = self._factor_scalar(self._powers) if self.free.size else None
 
     def _factor_scalar(self, powers):
         scalar = sp.diags(self._rest_diagonal * 4.0 ** powers) - self._coupling
-        return factor(scalar, symmetric=True)
+        return factor(scalar, symmetric=True, order=self._order, approximate=True)
 
     def _preconditioner(self, D):
         """The scalar preconditioner for the free blocks ``D``: the one of the rest scale, or
