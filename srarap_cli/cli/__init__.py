@@ -9,6 +9,7 @@ import sys
 import click
 
 from ..runtime import signals, streams
+from ..runtime.lazy_modules import defer_unused_numpy_modules
 from ..runtime.threads import pin_process
 
 #: name -> (module, function, one-line help shown by ``srarap --help``)
@@ -43,6 +44,8 @@ class LazyGroup(click.Group):
         if name not in COMMANDS:
             return None
         module, attr, _ = COMMANDS[name]
+        # imports numpy: here, after main's BLAS thread settings, and not for ``srarap --help``
+        defer_unused_numpy_modules()
         return getattr(importlib.import_module(f".{module}", __name__), attr)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True,
