@@ -88,7 +88,10 @@ SETTINGS = (
             "Pull of each rotor toward its previous value (paper's eps).", "setup", minimum=0),
     Setting("weights", "choice", "cotan-clamped", "Edge weights.", "setup",
             choices=WEIGHT_KINDS),
-    Setting("method", "choice", "sr-linear-sym", "Local step (see README).", "setup",
+    Setting("method", "choice", "sr-linear-sym",
+            "Local step: sr-linear-sym (the symmetric form of the paper's one-solve system), "
+            "sr-linear (the paper's system), sr-relax (per-cell relaxation), arap (classic "
+            "ARAP, no bending).", "setup",
             choices=tuple(METHODS)),
     Setting("handle_rotors", "choice", "boundary",
             "Rotors of constrained vertices: only a handle's boundary cells take theirs from "
