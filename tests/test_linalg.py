@@ -101,3 +101,26 @@ def test_an_approximate_factor_is_single_precision_and_answers_in_double(monkeyp
     assert x.dtype == np.float64
     error = np.abs(x - exact).max() / np.abs(exact).max()
     assert 1e-12 < error < 1e-5  # single precision: neither exact nor far off
+
+
+def _fill(A, order):
+    import scipy.sparse.linalg as spla
+    P = sp.csc_matrix(sp.csr_matrix(A)[order][:, order])
+    lu = spla.splu(P, permc_spec="NATURAL", options={"SymmetricMode": True})
+    return lu.L.nnz + lu.U.nnz
+
+
+def test_the_mesh_order_dissects_every_edge_even_of_zero_weight():
+    """A tube of rectangles split in two has right angles: their diagonals' clamped cotangent
+    weights are 0 and the Laplacian stores no entry for them, but the rotor matrix couples
+    them. The mesh order, restricted to any rows, must fill a matrix on all the edges about
+    as well as that matrix's own nested dissection."""
+    V, F = tube(length=20.0, rings=80, segments=24)
+    graph = Deformer(V, F, ends(V, 20.0), prepare=False).graph
+    assert graph.laplacian.nnz < graph.I.size + graph.n  # zero weights were dropped
+    every_edge = sp.csr_matrix((np.full(graph.I.size, -1.0), (graph.I, graph.J)),
+                               shape=(graph.n,) * 2)
+    M = (every_edge + sp.diags(graph.degree + 1.0)).tocsr()
+    rows = np.flatnonzero((V[:, 2] > 0.5) & (V[:, 2] < 19.5))
+    sub = M[rows][:, rows]
+    assert _fill(sub, graph.fill_order(rows)) <= 1.2 * _fill(sub, linalg.fill_order(sub))
