@@ -4,15 +4,18 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 from helpers import ROOT
 
 from srarap_cli.io.handles import load_handles
 from srarap_cli.io.mesh import read_mesh
 
 
-def test_readme_handle_example_loads(tmp_path):
-    text = Path(ROOT, "README.md").read_text(encoding="utf-8")
-    section = text[text.index("## Handle files"):]
+@pytest.mark.parametrize("page, heading", [("README.md", "## Handle files"),
+                                           ("docs/guides/handle-files.md", "# ")])
+def test_the_complete_handle_example_loads(tmp_path, page, heading):
+    text = Path(ROOT, page).read_text(encoding="utf-8")
+    section = text[text.index(heading):]
     example = re.search(r"```yaml\n(.*?)```", section, re.DOTALL).group(1)
     (tmp_path / "handles.yaml").write_text(example)
     V = read_mesh(os.path.join(ROOT, "sample_meshes", "bar.obj")).vertices
@@ -80,3 +83,24 @@ def test_the_guides_manifest_example_is_a_valid_manifest(tmp_path):
     jobs = load_manifest(str(path))
     assert [j["name"] for j in jobs] == ["bar-twist"] and os.path.exists(jobs[0]["mesh"])
     assert os.path.exists(jobs[0]["expect"]["golden"])
+
+
+def test_the_guides_make_rule_builds_its_target_and_then_has_nothing_to_do(tmp_path):
+    import shutil
+    import subprocess
+    import sys
+
+    guide = Path(ROOT, "docs", "guides", "workflows.md").read_text(encoding="utf-8")
+    rule = re.search(r"```make\n(.*?)```", guide, re.DOTALL).group(1)
+    (tmp_path / "Makefile").write_text(rule)
+    shutil.copy(Path(ROOT, "sample_meshes", "bar.obj"), tmp_path / "bar.obj")
+    shutil.copy(Path(ROOT, "configs", "bar-twist.yaml"), tmp_path / "twist.yaml")
+    env = {**os.environ, "PATH": os.path.dirname(sys.executable) + os.pathsep
+           + os.environ["PATH"]}
+    first = subprocess.run(["make", "twisted.obj"], cwd=tmp_path, env=env,
+                           capture_output=True, text=True)
+    assert first.returncode == 0, first.stderr
+    assert (tmp_path / "twisted.obj").stat().st_size > 0 and (tmp_path / "twisted.csv").exists()
+    again = subprocess.run(["make", "twisted.obj"], cwd=tmp_path, env=env,
+                           capture_output=True, text=True)
+    assert "up to date" in again.stdout
