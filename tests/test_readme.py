@@ -104,3 +104,20 @@ def test_the_guides_make_rule_builds_its_target_and_then_has_nothing_to_do(tmp_p
     again = subprocess.run(["make", "twisted.obj"], cwd=tmp_path, env=env,
                            capture_output=True, text=True)
     assert "up to date" in again.stdout
+
+
+def test_the_python_guide_runs_as_written(tmp_path):
+    """Its blocks in order, in one interpreter, in a folder holding the samples."""
+    import subprocess
+    import sys
+
+    guide = Path(ROOT, "docs", "guides", "python.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", guide, re.DOTALL)
+    assert len(blocks) >= 4
+    subprocess.run([os.path.join(os.path.dirname(sys.executable), "srarap"), "samples",
+                    str(tmp_path), "-q"], check=True)
+    p = subprocess.run([sys.executable, "-c", "".join(blocks)], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert (tmp_path / "twisted.obj").exists() and (tmp_path / "turn_180.obj").exists()
+    assert p.stdout.splitlines()[-1].startswith("True")
