@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..io.input_files import read_input_bytes
+from ..runtime.allocator import keep_freed_memory
 from ..runtime.errors import InputError, excerpt
 from ..solver.mesh_checks import mesh_warnings
 from ..solver.quaternion import align_hemisphere, multiply, normalize
@@ -77,6 +78,7 @@ class Animator:
         self.constraints = constraints
         self.problem = problem(mesh, constraints, name)
         self.deformer = build_deformer(self.problem, opts, cache)
+        keep_freed_memory()  # after the setup, whose large arrays are allocated once
         self.solve_options = {"accel": opts.accel, "start": opts.start}
         #: what the problem and the solver found worth a warning (e.g. mesh problems)
         self.warnings = mesh_warnings(mesh.vertices, mesh.triangles()[0]) + list(

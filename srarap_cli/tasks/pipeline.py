@@ -7,6 +7,7 @@ import numpy as np
 
 from ..io.handles import Constraints
 from ..io.mesh import Mesh
+from ..runtime.allocator import keep_freed_memory
 from ..runtime.errors import InputError
 from ..solver.deformer import DeformResult
 from ..solver.mesh_checks import geometry_problem, mesh_warnings, solvable_faces
@@ -128,6 +129,7 @@ def deform_mesh(mesh: Mesh, constraints: Constraints,
     opts = settings if settings is not None else resolve(constraints.solver, overrides)
     p = problem(mesh, constraints, name)
     deformer = build_deformer(p, opts, cache)
+    keep_freed_memory()  # after the setup, whose large arrays are allocated once
     sub_result = deformer.solve(p.targets, callback=callback, **opts.stage("solve"))
     positions = scatter(mesh, p, sub_result.positions, constraints)
     rotors = np.tile(IDENTITY, (len(positions), 1))

@@ -120,7 +120,7 @@ class RotorSystem:
         solve = self._precondition
         # with its dtype given, LinearOperator does not try a preconditioner solve to guess it
         precond = spla.LinearOperator(
-            A.shape, matvec=lambda v: solve(np.asfortranarray(v.reshape(-1, 4))).ravel(),
+            A.shape, matvec=lambda v: solve(v.reshape(-1, 4)).ravel(),
             dtype=float)
         # CG for the correction from x0, whose right-hand side is x0's residual: relative to
         # it, the forcing is CG's own rtol, and CG needs no second product for its residual

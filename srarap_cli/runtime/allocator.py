@@ -1,0 +1,29 @@
+"""Keep freed memory in the process while it solves (glibc's malloc).
+
+glibc serves every allocation above its mmap threshold (32 MB at most) with a fresh mapping
+and unmaps it on free, so each large temporary of an iteration (a 738k-vertex mesh's 4x4
+rotor blocks are 94 MB) costs page faults and zeroing again, every time: at 738k vertices
+9.4 s of system time in 30 s (setup and 6 iterations), 4.7 s with the memory kept for reuse,
+wall time 14% lower, peak resident memory 6% higher. Small meshes allocate below the
+threshold and are unaffected. Elsewhere than glibc this does nothing.
+"""
+import ctypes
+
+# mallopt parameters (malloc.h)
+_M_TRIM_THRESHOLD = -1
+_M_TOP_PAD = -2
+_M_MMAP_MAX = -4
+_TOP_PAD = 64 << 20  # heap growth per brk: fewer, larger extensions
+
+
+def keep_freed_memory() -> bool:
+    """Serve large allocations from the heap and keep what is freed for reuse (no mmap per
+    allocation, no trimming). Process-wide: for srarap's own processes (the command line and
+    the workers it forks), not for a library call. Returns whether glibc took the settings."""
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):
+        return False
+    mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
+    settings = ((_M_MMAP_MAX, 0), (_M_TRIM_THRESHOLD, 2**31 - 1), (_M_TOP_PAD, _TOP_PAD))
+    return all(mallopt(param, value) == 1 for param, value in settings)
