@@ -12,6 +12,7 @@ changes the faces, neighbours or quadrics another one was checked against, and n
 moves, so every check made at the start of the round still holds when all are applied.
 """
 import numpy as np
+import scipy.sparse as sp
 
 from ..group_rotations import label_sum
 
@@ -194,10 +195,9 @@ def _keeps_shape(V, surface, rings, u, v):
 
 def _quality(V, T, normal):
     """4 sqrt(3) area / sum of squared edge lengths, per triangle."""
-    edges = np.stack([V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 1]],
-                      V[T[:, 0]] - V[T[:, 2]]], axis=1)
-    return 2 * np.sqrt(3) * np.linalg.norm(normal, axis=1) / np.maximum(
-        np.einsum("ijk,ijk->i", edges, edges), 1e-300)
+    a, b, c = _corners(V, T)
+    squares = sum(np.einsum("ij,ij->i", e, e) for e in (b - a, c - b, a - c))
+    return 2 * np.sqrt(3) * np.linalg.norm(normal, axis=1) / np.maximum(squares, 1e-300)
 
 
 def _vertex_normals(V, F):
@@ -212,15 +212,15 @@ class _Rings:
 
     def __init__(self, edges, F, n):
         self.F = F
-        keys = np.concatenate([edges[:, 0] * n + edges[:, 1], edges[:, 1] * n + edges[:, 0]])
-        self.keys = np.sort(keys)
-        self.nbr = self.keys % n
         self.n = n
-        self.nbr_ptr = np.searchsorted(self.keys, np.arange(n + 1) * n)
-        corner = F.ravel()
-        order = np.argsort(corner, kind="stable")
-        self.face = order // 3
-        self.face_ptr = np.searchsorted(corner[order], np.arange(n + 1))
+        # Both as a counting sort (scipy's COO -> CSR keeps the input order within each row)
+        # instead of two sorts. ``edges`` is sorted by (low, high): its reversed pairs first,
+        # then the pairs, lists each vertex's lower neighbours, then its higher ones, each in
+        # increasing order: sorted rows.
+        self.nbr_ptr, self.nbr = _csr(np.concatenate([edges[:, 1], edges[:, 0]]),
+                                      np.concatenate([edges[:, 0], edges[:, 1]]), n)
+        self.keys = np.repeat(np.arange(n), np.diff(self.nbr_ptr)) * n + self.nbr
+        self.face_ptr, self.face = _csr(F.ravel(), np.repeat(np.arange(len(F)), 3), n)
 
     def closed(self, u):
         """(owner, member) pairs: member runs over u[owner] and its neighbours."""
@@ -253,16 +253,41 @@ def _segments(ptr, values, rows):
     return owner, values[ptr[rows][owner] + offset]
 
 
+def _csr(rows, values, n):
+    """(ptr, values) of ``values`` grouped by ``rows`` (n groups), in their order within
+    each group: a stable counting sort."""
+    A = sp.csr_matrix((np.ones(rows.size, dtype=np.int8), (rows, values)),
+                      shape=(n, int(values.max(initial=-1)) + 1))
+    return A.indptr.astype(np.int64), A.indices.astype(np.int64)
+
+
 def _edges(F, n):
     """Undirected edges (sorted pairs) and how many triangles hold each."""
     a = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
     b = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
-    keys, count = np.unique(np.minimum(a, b) * n + np.maximum(a, b), return_counts=True)
-    return np.stack([keys // n, keys % n], axis=1), count
+    # summing duplicates sorts each row's few entries: cheaper than sorting all the keys
+    A = sp.csr_matrix((np.ones(a.size, dtype=np.int32), (np.minimum(a, b), np.maximum(a, b))),
+                      shape=(n, n))
+    A.sum_duplicates()
+    low = np.repeat(np.arange(n), np.diff(A.indptr))
+    return np.stack([low, A.indices.astype(np.int64)], axis=1), A.data
 
 
 def _normals(V, T):
-    return np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]])
+    a, b, c = _corners(V, T)
+    return _cross(b - a, c - a)
+
+
+def _corners(V, T):
+    """The three corner positions of each triangle, (t, 3) each."""
+    return [np.take(V, T[:, k], axis=0) for k in range(3)]
+
+
+def _cross(x, y):
+    """Row-wise cross products, written out (np.cross copies its inputs around)."""
+    return np.column_stack([x[:, 1] * y[:, 2] - x[:, 2] * y[:, 1],
+                            x[:, 2] * y[:, 0] - x[:, 0] * y[:, 2],
+                            x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]])
 
 
 def _vertex_quadrics(V, F):
@@ -322,5 +347,7 @@ def _costs(Q, lifted, u, v, chunk=1 << 20):
     out = np.empty(u.size)
     for s in range(0, u.size, chunk):
         uu, vv = u[s:s + chunk], v[s:s + chunk]
-        out[s:s + chunk] = np.einsum("ik,ik->i", Q[uu], lifted[vv]) + own[vv]
+        # np.take gathers rows 2-3 times faster than fancy indexing (same values)
+        out[s:s + chunk] = (np.einsum("ik,ik->i", np.take(Q, uu, axis=0),
+                                      np.take(lifted, vv, axis=0)) + np.take(own, vv))
     return np.maximum(out, 0.0)
