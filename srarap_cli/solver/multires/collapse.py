@@ -15,6 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..group_rotations import label_sum
+from ..mesh_checks import edge_counts
 
 #: Weight of the point quadric (distance to the collapsed original vertices) relative to the
 #: plane quadrics, per unit of vertex area: it breaks ties on flat regions in favour of short
@@ -87,7 +88,7 @@ def _round(V, lifted, surface, F, Q, frozen, banned, need):
     Checks run only on the winners: most proposals pass them, and checking every vertex's
     proposal each round cost several times the rest of the round."""
     n = len(V)
-    edges, count = _edges(F, n)
+    edges, count = edge_counts(F)
     fixed = frozen.copy()
     fixed[edges[count > 2].ravel()] = True
     border = np.zeros(n, dtype=bool)
@@ -259,18 +260,6 @@ def _csr(rows, values, n):
     A = sp.csr_matrix((np.ones(rows.size, dtype=np.int8), (rows, values)),
                       shape=(n, int(values.max(initial=-1)) + 1))
     return A.indptr.astype(np.int64), A.indices.astype(np.int64)
-
-
-def _edges(F, n):
-    """Undirected edges (sorted pairs) and how many triangles hold each."""
-    a = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
-    b = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
-    # summing duplicates sorts each row's few entries: cheaper than sorting all the keys
-    A = sp.csr_matrix((np.ones(a.size, dtype=np.int32), (np.minimum(a, b), np.maximum(a, b))),
-                      shape=(n, n))
-    A.sum_duplicates()
-    low = np.repeat(np.arange(n), np.diff(A.indptr))
-    return np.stack([low, A.indices.astype(np.int64)], axis=1), A.data
 
 
 def _normals(V, T):
