@@ -121,3 +121,49 @@ def test_the_python_guide_runs_as_written(tmp_path):
     assert p.returncode == 0, p.stderr[-2000:]
     assert (tmp_path / "twisted.obj").exists() and (tmp_path / "turn_180.obj").exists()
     assert p.stdout.splitlines()[-1].startswith("True")
+
+
+def test_the_guides_dask_worker_command_serves_a_batch(tmp_path):
+    """The worker command as written (host and port filled in) joins a scheduler, and a batch
+    of the guide's manifest runs on it."""
+    import shutil
+    import signal
+    import socket
+    import subprocess
+    import sys
+    import time
+
+    guide = Path(ROOT, "docs", "guides", "workflows.md").read_text(encoding="utf-8")
+    command = re.search(r"```\n(OPENBLAS_NUM_THREADS=1 dask worker .*?)```", guide,
+                        re.DOTALL).group(1).strip()
+    manifest = re.search(r"```yaml\n(.*?)```", guide, re.DOTALL).group(1)
+    (tmp_path / "configs").mkdir()
+    os.symlink(Path(ROOT, "sample_meshes"), tmp_path / "sample_meshes")
+    os.symlink(Path(ROOT, "srarap_cli", "data", "golden"), tmp_path / "golden")
+    shutil.copy(Path(ROOT, "configs", "bar-twist.yaml"), tmp_path / "configs")
+    (tmp_path / "configs" / "guide.yaml").write_text(manifest)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    bindir = os.path.dirname(sys.executable)
+    env = {**os.environ, "PATH": bindir + os.pathsep + os.environ["PATH"]}
+    address = f"tcp://127.0.0.1:{port}"
+    started = [subprocess.Popen([os.path.join(bindir, "dask"), "scheduler", "--host",
+                                 "127.0.0.1", "--port", str(port), "--no-dashboard"],
+                                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                start_new_session=True)]
+    try:
+        time.sleep(2)  # tasks wait for a worker anyway; this only keeps the log tidy
+        started.append(subprocess.Popen(["bash", "-c", command.replace("tcp://host:8786",
+                                                                       address)],
+                                        env=env, cwd=tmp_path, stdout=subprocess.DEVNULL,
+                                        stderr=subprocess.DEVNULL, start_new_session=True))
+        p = subprocess.run([os.path.join(bindir, "srarap"), "batch", "configs/guide.yaml",
+                            "-o", "out", "--scheduler", address], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stderr[-2000:]
+        assert (tmp_path / "out" / "bar-twist.obj").exists()
+    finally:
+        for proc in started:
+            os.killpg(proc.pid, signal.SIGTERM)
+            proc.wait(timeout=30)
