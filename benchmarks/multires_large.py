@@ -10,7 +10,8 @@ stage table of the performance page:
     python benchmarks/make_big_bar.py out/bar-500k.obj --rings 1560 --segments 320
     python benchmarks/make_big_spot.py out/cylinder-1m.obj --levels 4 --mesh ../shared/meshes/cylinder.off
     python benchmarks/make_big_bar.py out/bar-2m.obj --rings 3120 --segments 640
-    python benchmarks/multires_large.py --multires auto --cold-only --mesh out/bar-500k.obj --handles benchmarks/cases/bar-100k-twist.yaml
+    python benchmarks/multires_large.py --cold-only --mesh out/bar-500k.obj \
+        --handles benchmarks/cases/bar-100k-twist.yaml
 
 Run: python benchmarks/multires_large.py [--multires auto] [--runs 1] [--mesh M --handles H]
 """

@@ -3,6 +3,8 @@
 Written by hand because meshio's reader rejects common headers (for example a double space
 in the count line) and libigl's triangulates polygons away.
 """
+import warnings
+
 import numpy as np
 
 from ...runtime.errors import InputError, excerpt
@@ -20,6 +22,56 @@ def _tokens(path):
 
 def read_off(path):
     """Read an OFF file into a :class:`Mesh` (vertex normals and ST texture coords kept)."""
+    with open_input(path, encoding="utf-8", errors="replace") as fh:
+        plain = _read_plain(fh.read())
+    return plain if plain is not None else _read_general(path)
+
+
+def _read_plain(text):
+    """The mesh of a plain OFF file (keyword ``OFF``, no comments, three numbers on every
+    vertex line, ``k`` and ``k`` indices on every face line), parsed in bulk by numpy's C
+    parser: a 738k-vertex file in a fraction of the line-by-line time. None for anything
+    else, which :func:`_read_general` reads or reports."""
+    if "#" in text:
+        return None
+    lines = text.splitlines()
+    head = lines[0].split() if lines else []
+    if not head or head[0] != "OFF":
+        return None
+    start = 1 if len(head) > 1 else 2
+    counts = head[1:] if len(head) > 1 else (lines[1].split() if len(lines) > 1 else [])
+    try:
+        nv, nf = int(counts[0]), int(counts[1])
+    except (IndexError, ValueError):
+        return None
+    vertex_lines = lines[start:start + nv]
+    face_lines = lines[start + nv:start + nv + nf]
+    if len(vertex_lines) != nv or len(face_lines) != nf or nf == 0 \
+            or any(line.strip() for line in lines[start + nv + nf:]):
+        return None
+    widths = np.fromiter((len(line.split()) for line in face_lines), dtype=np.int64, count=nf)
+    if any(len(line.split()) != 3 for line in vertex_lines) or (widths < 4).any():
+        return None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            V = np.fromstring(" ".join(vertex_lines), sep=" ")
+            values = np.fromstring(" ".join(face_lines), dtype=np.int64, sep=" ")
+    except (ValueError, DeprecationWarning):
+        return None
+    first = np.cumsum(widths) - widths
+    sizes = values[first] if values.size == widths.sum() else None
+    if V.size != 3 * nv or sizes is None or not np.array_equal(sizes, widths - 1):
+        return None
+    keep = np.ones(values.size, dtype=bool)
+    keep[first] = False
+    corners = values[keep]
+    if (corners < 0).any() or (corners >= nv).any():
+        return None
+    return Mesh(vertices=V.reshape(nv, 3), face_sizes=sizes, face_vertices=corners)
+
+
+def _read_general(path):
     lines = _tokens(path)
     try:
         header = next(lines)
