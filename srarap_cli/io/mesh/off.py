@@ -121,8 +121,14 @@ def format_off(mesh):
     if len(cols):
         parts.append((("%.17g " * (cols.shape[1] - 1) + "%.17g\n") * len(cols))
                      % tuple(cols.ravel()))
+    sizes = mesh.face_sizes
+    if sizes.size and (sizes == sizes[0]).all():  # one format for all rows, not one per face
+        k = int(sizes[0])
+        rows = np.column_stack([sizes, mesh.face_vertices.reshape(-1, k)])
+        parts.append((("%d " * k + "%d\n") * len(rows)) % tuple(rows.ravel().tolist()))
+        return "".join(parts)
     offsets = mesh.face_offsets
     fv = mesh.face_vertices.astype(str)
-    parts.extend(f"{mesh.face_sizes[i]} " + " ".join(fv[offsets[i]:offsets[i + 1]]) + "\n"
-                 for i in range(mesh.face_sizes.size))
+    parts.extend(f"{sizes[i]} " + " ".join(fv[offsets[i]:offsets[i + 1]]) + "\n"
+                 for i in range(sizes.size))
     return "".join(parts)
