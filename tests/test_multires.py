@@ -322,3 +322,29 @@ def test_a_mesh_that_does_not_simplify_is_solved_directly_with_a_warning():
     direct = make_deformer(Vs, Fs, held, multires="off")
     assert np.array_equal(multi.solve(moved, tol=1e-8).positions,
                           direct.solve(moved, tol=1e-8).positions)
+
+
+def test_a_warm_solve_calls_on_the_coarse_mesh_only_when_it_needs_many_iterations():
+    """A warm start near the answer converges without a coarse step (none is even built);
+    one far from it gets coarse-grid corrections once WARM_UNCORRECTED iterations passed,
+    and both end where a cold solve ends."""
+    from helpers import diagonal, ends, twist
+
+    from srarap_cli.solver.multires import deformer as mr
+
+    V, F = tube(length=6.0, rings=40, segments=16)
+    ids = ends(V)
+    d = MultiresDeformer(V, F, ids, size=120)
+    T = twist(V, ids, 6.0, 60)
+    cold = d.solve(T, tol=1e-9)
+    built = []
+    real = d.coarse_correction
+    d.coarse_correction = lambda *a: built.append(1) or real(*a)
+    near = d.solve(T, initial=(cold.positions, cold.rotors), tol=1e-9)
+    assert near.converged and near.iterations <= mr.WARM_UNCORRECTED and not built
+    far = d.solve(T, initial=(V, np.tile([1.0, 0, 0, 0], (len(V), 1))), tol=1e-9)
+    steps = [row["step"] for row in far.log]
+    assert far.converged and built and "corrected" in steps
+    assert "corrected" not in steps[:mr.WARM_UNCORRECTED + 1]
+    for r in (near, far):
+        assert np.abs(r.positions - cold.positions).max() < 1e-4 * diagonal(V)
