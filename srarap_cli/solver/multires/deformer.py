@@ -92,16 +92,18 @@ class _Delayed:
     """A coarse-grid correction that is never due in the first ``after`` iterations, built
     on first use (``make()``), so a solve that stops before needs no coarse step at all."""
 
-    def __init__(self, make, after):
-        self.make, self.after, self.correction = make, after, None
+    def __init__(self, make: Callable[[], CoarseCorrection], after: int) -> None:
+        self.make, self.after = make, after
+        self.correction: CoarseCorrection | None = None
 
-    def due(self, iteration):
+    def due(self, iteration: int) -> bool:
         if iteration <= self.after:
             return False
         self.correction = self.correction or self.make()
         return self.correction.due(iteration)
 
-    def __call__(self, rotors, residual):
+    def __call__(self, rotors: np.ndarray, residual: np.ndarray) -> np.ndarray | None:
+        assert self.correction is not None  # due() came first
         return self.correction(rotors, residual)
 
 
