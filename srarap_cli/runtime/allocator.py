@@ -18,8 +18,10 @@ _TOP_PAD = 64 << 20  # heap growth per brk: fewer, larger extensions
 
 def keep_freed_memory() -> bool:
     """Serve large allocations from the heap and keep what is freed for reuse (no mmap per
-    allocation, no trimming). Process-wide: for srarap's own processes (the command line and
-    the workers it forks), not for a library call. Returns whether glibc took the settings."""
+    allocation, no trimming). Process-wide, so called by the commands' tasks once their
+    setup is done (deform, animate, and each batch job, also in a Dask worker), never by the
+    Python API, which leaves its caller's process alone. Returns whether glibc took the
+    settings."""
     try:
         mallopt = ctypes.CDLL(None).mallopt
     except (OSError, AttributeError):
