@@ -3,6 +3,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .libigl import igl
+from .operators import triangle_normals
 
 NEEDLE_DEGREES = 1.0
 
@@ -27,7 +28,7 @@ def geometry_problem(V, F):
     if not 1e-100 < diag < 1e100:
         return (f"its vertices span {diag:.3g}: too small or too large to solve in double "
                 "precision; rescale the mesh")
-    area = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    area = np.linalg.norm(triangle_normals(V, F), axis=1)
     if np.all(area <= 1e-14 * diag * diag):
         return "every triangle has zero area (collinear or coincident vertices)"
     return None

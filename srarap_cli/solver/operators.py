@@ -142,3 +142,21 @@ def cell_graph(V, F, weights="cotan-clamped"):
     return CellGraph(I=I, J=W.indices.astype(np.int64), c=W.data.copy(),
                      degree=np.diff(W.indptr), laplacian=K, area=area,
                      degenerate=int((~finite).sum()))
+
+
+def triangle_normals(V, F):
+    """Unnormalized normals of triangles ``F`` (t, 3) of ``V`` (n, 3): ``(b - a) x (c - a)``,
+    twice each triangle's area long: (t, 3). Rows gathered with ``np.take`` and the cross
+    product written out (``np.cross`` copies its inputs around): the same values, several
+    times faster on millions of triangles.
+
+    Examples
+    --------
+    >>> triangle_normals(np.eye(3), np.array([[0, 1, 2]])).tolist()
+    [[1.0, 1.0, 1.0]]
+    """
+    a, b, c = (np.take(V, F[:, k], axis=0) for k in range(3))
+    x, y = b - a, c - a
+    return np.column_stack([x[:, 1] * y[:, 2] - x[:, 2] * y[:, 1],
+                            x[:, 2] * y[:, 0] - x[:, 0] * y[:, 2],
+                            x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]])

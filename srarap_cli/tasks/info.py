@@ -7,6 +7,7 @@ from ..io.handles import Constraints
 from ..io.mesh import Mesh
 from ..solver.group_rotations import group_rotors
 from ..solver.mesh_checks import edge_adjacency, edge_counts, mesh_warnings
+from ..solver.operators import triangle_normals
 from ..solver.quaternion import IDENTITY, to_matrix
 from .pipeline import problem
 
@@ -129,7 +130,7 @@ def _up_guess(V, F):
     """y or z, whichever the mesh more likely stands on: the one whose lowest slab carries
     more downward-facing area (a base, feet, a bottom); y on a tie, as most OBJ and PLY
     files are y-up. A guess, and said to be one: a lying cylinder fools it."""
-    normals = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]) / 2
+    normals = triangle_normals(V, F) / 2
     centers = V[F].mean(axis=1)
     lo, hi = V.min(axis=0), V.max(axis=0)
     scores = {}

@@ -4,13 +4,13 @@ Written by hand because meshio drops ``vt``/``vn`` indices and rejects UV seams 
 per-corner normals, and libigl's reader keeps no polygons of mixed size or other statements.
 """
 import re
-import warnings
 
 import numpy as np
 
 from ...runtime.errors import InputError, excerpt
 from ..input_files import open_input
 from .mesh import Mesh
+from .numbers import parse_numbers
 
 
 def _floats(rows, width, path, what):
@@ -57,15 +57,8 @@ def _read_plain(text):
         return None
     verts = re.findall(r"^v (.*)$", text, re.M)
     faces = re.findall(r"^f (.*)$", text, re.M)
-    try:
-        # numpy's C text parser (a few times faster than Python's split on millions of
-        # numbers); anything it cannot read to the end is an error here, left to the
-        # general reader, and a saturated huge index fails the range check below
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            V = np.fromstring(" ".join(verts), sep=" ")
-            corners = np.fromstring(" ".join(faces), dtype=np.int64, sep=" ")
-    except (ValueError, OverflowError, DeprecationWarning):
+    V, corners = parse_numbers(verts), parse_numbers(faces, dtype=np.int64)
+    if V is None or corners is None:
         return None
     sizes = np.fromiter((len(f.split()) for f in faces), dtype=np.int64, count=len(faces))
     if V.size != 3 * len(verts) or (sizes < 3).any() or corners.size != sizes.sum() \

@@ -3,13 +3,12 @@
 Written by hand because meshio's reader rejects common headers (for example a double space
 in the count line) and libigl's triangulates polygons away.
 """
-import warnings
-
 import numpy as np
 
 from ...runtime.errors import InputError, excerpt
 from ..input_files import open_input
 from .mesh import Mesh
+from .numbers import parse_numbers
 
 
 def _tokens(path):
@@ -52,12 +51,8 @@ def _read_plain(text):
     widths = np.fromiter((len(line.split()) for line in face_lines), dtype=np.int64, count=nf)
     if any(len(line.split()) != 3 for line in vertex_lines) or (widths < 4).any():
         return None
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            V = np.fromstring(" ".join(vertex_lines), sep=" ")
-            values = np.fromstring(" ".join(face_lines), dtype=np.int64, sep=" ")
-    except (ValueError, DeprecationWarning):
+    V, values = parse_numbers(vertex_lines), parse_numbers(face_lines, dtype=np.int64)
+    if V is None or values is None:
         return None
     first = np.cumsum(widths) - widths
     sizes = values[first] if values.size == widths.sum() else None

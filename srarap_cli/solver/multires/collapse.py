@@ -16,6 +16,7 @@ import scipy.sparse as sp
 
 from ..group_rotations import label_sum
 from ..mesh_checks import edge_counts
+from ..operators import triangle_normals
 
 #: Weight of the point quadric (distance to the collapsed original vertices) relative to the
 #: plane quadrics, per unit of vertex area: it breaks ties on flat regions in favour of short
@@ -180,11 +181,11 @@ def _keeps_shape(V, surface, rings, u, v):
     T = rings.F[faces]
     keep = ~np.any(T == v[owner, None], axis=1)
     owner, T = owner[keep], T[keep]
-    before = _normals(V, T)
+    before = triangle_normals(V, T)
     worst = np.full(u.size, np.inf)
     np.minimum.at(worst, owner, _quality(V, T, before))
     T = np.where(T == u[owner, None], v[owner, None], T)
-    after = _normals(V, T)
+    after = triangle_normals(V, T)
     size_b = np.linalg.norm(before, axis=1)
     size_a = np.linalg.norm(after, axis=1)
     good = ((np.einsum("ij,ij->i", before, after) > MIN_NORMAL_COS * size_b * size_a)
@@ -203,7 +204,7 @@ def _quality(V, T, normal):
 
 def _vertex_normals(V, F):
     """Area-weighted unit vertex normals of the input surface."""
-    normal = _normals(V, F)
+    normal = triangle_normals(V, F)
     out = label_sum(np.repeat(normal, 3, axis=0), F.ravel(), len(V))
     return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
 
@@ -262,21 +263,9 @@ def _csr(rows, values, n):
     return A.indptr.astype(np.int64), A.indices.astype(np.int64)
 
 
-def _normals(V, T):
-    a, b, c = _corners(V, T)
-    return _cross(b - a, c - a)
-
-
 def _corners(V, T):
     """The three corner positions of each triangle, (t, 3) each."""
     return [np.take(V, T[:, k], axis=0) for k in range(3)]
-
-
-def _cross(x, y):
-    """Row-wise cross products, written out (np.cross copies its inputs around)."""
-    return np.column_stack([x[:, 1] * y[:, 2] - x[:, 2] * y[:, 1],
-                            x[:, 2] * y[:, 0] - x[:, 0] * y[:, 2],
-                            x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]])
 
 
 def _vertex_quadrics(V, F):
@@ -284,7 +273,7 @@ def _vertex_quadrics(V, F):
     its triangles, planes through border edges perpendicular to their triangle, and a small
     point quadric at the vertex."""
     n = len(V)
-    normal = _normals(V, F)
+    normal = triangle_normals(V, F)
     double_area = np.linalg.norm(normal, axis=1)
     unit = normal / np.maximum(double_area, 1e-300)[:, None]
     planes = np.column_stack([unit, -np.einsum("ij,ij->i", unit, V[F[:, 0]])])
