@@ -1,9 +1,12 @@
 """Sparse factorizations shared by the Poisson solve and the rotor systems' preconditioner."""
+import contextlib
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..runtime.errors import SingularSystemError
+from ..runtime.fpu import subnormals_flushed
 from ..runtime.limits import is_out_of_memory
 from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
@@ -55,7 +58,8 @@ def factor(A, symmetric, order=None, approximate=False):
     approximate : bool, an approximate solve is enough (a preconditioner): a large symmetric
         ``A`` is then factored in single precision, which halves the memory its factors take
         and the traffic of its triangular solves (738k vertices: 0.20 -> 0.16 s a 4-column
-        solve); the solution comes back in double precision
+        solve), with subnormal numbers flushed to zero (see :mod:`..runtime.fpu`); the
+        solution comes back in double precision
 
     Examples
     --------
@@ -88,7 +92,9 @@ def _superlu(A, permc_spec, options):
 def _nested_dissection(A, order):
     """SuperLU of a symmetric ``A`` in the order ``order``: ``solve(b)``."""
     permuted = sp.csc_matrix(sp.csr_matrix(A)[order][:, order])
-    lu = _superlu(permuted, "NATURAL", {"SymmetricMode": True})
+    single = permuted.dtype == np.float32
+    with _flushed(single):
+        lu = _superlu(permuted, "NATURAL", {"SymmetricMode": True})
     inverse = np.empty_like(order)
     inverse[order] = np.arange(order.size)
 
@@ -96,9 +102,17 @@ def _nested_dissection(A, order):
         # np.take gathers rows several times faster than fancy indexing, and a gather by the
         # inverse order replaces the scatter: 109 -> 30 ms a 4-column solve's copies at 738k
         B = np.asfortranarray(np.take(np.asarray(b), order, axis=0), dtype=permuted.dtype)
-        return np.take(lu.solve(B), inverse, axis=0).astype(float, copy=False)
+        with _flushed(single):
+            X = lu.solve(B)
+        return np.take(X, inverse, axis=0).astype(float, copy=False)
 
     return solve
+
+
+def _flushed(single):
+    """Single-precision work flushes subnormals (its factor's fill decays to them); double
+    precision keeps IEEE arithmetic."""
+    return subnormals_flushed() if single else contextlib.nullcontext()
 
 
 def fill_order(A):
