@@ -30,9 +30,12 @@ from ..quaternion import align_hemisphere, normalize
 #: iterations instead of 16 (a correction every third iteration)
 COARSE_STEPS = 20
 #: ... or, when a coarser mesh corrects the coarse iteration in turn, this many: each step
-#: then does more and costs more (184k Spot through 20,000 and 5,000 coarse vertices: 23
-#: full-resolution iterations and 23 s to the stop; 20 steps: 19 and 33 s; 6 steps: 43, 32 s)
-NESTED_STEPS = 10
+#: then does more and costs more. Full-resolution iterations and their seconds to the stop,
+#: 10 steps against 6 (default settings, same process): 184k Spot 15, 14.1 s -> 15, 11.7 s;
+#: 500k bar twisted 90 degrees 23, 52.8 s -> 23, 40.0 s; 738k Spot 17, 47.0-53.9 s -> 17,
+#: 39.7-40.4 s; 1.2M cylinder 22, 130 s -> 23, 108 s. Fewer (3, 4) or a correction every
+#: iteration won on some meshes and lost on others (500k bar, 4 every iteration: 26, 57.7 s)
+NESTED_STEPS = 6
 #: the coarse iteration stops early once no rotor component changes by more than this
 COARSE_SETTLED = 1e-9
 #: a correction costs about COARSE_STEPS coarse steps, ``COARSE_STEPS * m / n`` full ones:
