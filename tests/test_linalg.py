@@ -1,4 +1,5 @@
 """Both factorization back ends solve the same systems."""
+import igl
 import numpy as np
 import scipy.sparse as sp
 from helpers import ends, tube
@@ -70,6 +71,7 @@ def test_one_nested_dissection_serves_the_poisson_matrix_and_the_rotor_precondit
     real = pymetis.nested_dissection
     monkeypatch.setattr(pymetis, "nested_dissection",
                         lambda *a, **k: runs.append(1) or real(*a, **k))
+    monkeypatch.setattr(linalg, "run_forked", lambda func, *args: func(*args))  # count here
     monkeypatch.setattr(linalg, "LARGE", 0)
     V, F = tube(length=6.0, rings=12, segments=8)
     ids = ends(V, 6.0)
@@ -124,3 +126,28 @@ def test_the_mesh_order_dissects_every_edge_even_of_zero_weight():
     rows = np.flatnonzero((V[:, 2] > 0.5) & (V[:, 2] < 19.5))
     sub = M[rows][:, rows]
     assert _fill(sub, graph.fill_order(rows)) <= 1.2 * _fill(sub, linalg.fill_order(sub))
+
+
+def test_the_order_from_a_forked_child_is_the_order_computed_here(monkeypatch):
+    """METIS runs in a child where it can (it holds the GIL); where it cannot, or the child
+    fails or answers nonsense, the parent computes the very same order itself."""
+    V, F = tube(length=6.0, rings=16, segments=10)
+    A = igl.cotmatrix(V, F)
+    forked = linalg.fill_order(A)
+    assert np.array_equal(np.sort(forked), np.arange(len(V)))
+    for answer in (None, b"", b"\x00" * 8 * len(V)):
+        monkeypatch.setattr(linalg, "run_forked", lambda func, *args, out=answer: out)
+        assert np.array_equal(linalg.fill_order(A), forked)
+
+
+def test_a_failing_child_reports_failure_and_a_working_one_its_bytes():
+    from srarap_cli.runtime import forked
+
+    def boom():
+        raise RuntimeError("in the child")
+
+    assert forked.run_forked(boom) is None
+    big = bytes(range(256)) * 40_000  # more than a pipe's buffer
+    assert forked.run_forked(lambda: big) in (big, None)
+    if forked._FORK_OK:
+        assert forked.run_forked(lambda: big) == big

@@ -6,6 +6,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..runtime.errors import SingularSystemError
+from ..runtime.forked import run_forked
 from ..runtime.fpu import subnormals_flushed
 from ..runtime.limits import is_out_of_memory
 from ..runtime.signals import deferred
@@ -119,6 +120,10 @@ def fill_order(A):
     """METIS nested dissection order of the graph of a symmetric sparse matrix's stored
     off-diagonal entries (explicit zeros count); vertices without any come first.
 
+    METIS runs in a forked child where the platform allows (:mod:`..runtime.forked`): it
+    keeps the GIL for its whole run, which stalled the simplification running beside it; the
+    order is the same either way.
+
     Parameters
     ----------
     A : (n, n) sparse matrix
@@ -137,5 +142,27 @@ def fill_order(A):
     ids = np.flatnonzero(linked)
     sub = graph[ids][:, ids]
     sub.sort_indices()
-    order = pymetis.nested_dissection(pymetis.CSRAdjacency(sub.indptr, sub.indices))[0]
-    return np.concatenate([np.flatnonzero(~linked), ids[np.asarray(order, dtype=np.int64)]])
+    adjacency = pymetis.CSRAdjacency(sub.indptr, sub.indices)
+    found = run_forked(_dissection_bytes, adjacency)
+    order = (np.frombuffer(found, dtype="<i8") if _is_permutation(found, ids.size)
+             else _dissection(adjacency))
+    return np.concatenate([np.flatnonzero(~linked), ids[order]])
+
+
+def _dissection(adjacency):
+    import pymetis
+
+    return np.asarray(pymetis.nested_dissection(adjacency)[0], dtype=np.int64)
+
+
+def _dissection_bytes(adjacency):
+    return _dissection(adjacency).astype("<i8").tobytes()
+
+
+def _is_permutation(found, n):
+    """Whether the child's bytes are a permutation of ``range(n)``."""
+    if found is None or len(found) != 8 * n:
+        return False
+    order = np.frombuffer(found, dtype="<i8")
+    return bool(n == 0 or (order.min() >= 0 and order.max() < n
+                           and np.bincount(order, minlength=n).max() == 1))
