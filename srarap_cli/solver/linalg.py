@@ -143,20 +143,19 @@ def fill_order(A):
     sub = graph[ids][:, ids]
     sub.sort_indices()
     adjacency = pymetis.CSRAdjacency(sub.indptr, sub.indices)
-    found = run_forked(_dissection_bytes, adjacency)
+    # the child gets the function itself: no import statement runs after the fork
+    found = run_forked(_dissection_bytes, pymetis.nested_dissection, adjacency)
     order = (np.frombuffer(found, dtype="<i8") if _is_permutation(found, ids.size)
-             else _dissection(adjacency))
+             else _dissection(pymetis.nested_dissection, adjacency))
     return np.concatenate([np.flatnonzero(~linked), ids[order]])
 
 
-def _dissection(adjacency):
-    import pymetis
-
-    return np.asarray(pymetis.nested_dissection(adjacency)[0], dtype=np.int64)
+def _dissection(nested_dissection, adjacency):
+    return np.asarray(nested_dissection(adjacency)[0], dtype=np.int64)
 
 
-def _dissection_bytes(adjacency):
-    return _dissection(adjacency).astype("<i8").tobytes()
+def _dissection_bytes(nested_dissection, adjacency):
+    return _dissection(nested_dissection, adjacency).astype("<i8").tobytes()
 
 
 def _is_permutation(found, n):
