@@ -77,12 +77,13 @@ class Animator:
         self.mesh = mesh
         self.constraints = constraints
         self.problem = problem(mesh, constraints, name)
+        # the mesh checks before the solver exists, so their temporaries do not add to it
+        mesh_notes = mesh_warnings(mesh.vertices, mesh.triangles()[0])
         self.deformer = build_deformer(self.problem, opts, cache)
         keep_freed_memory()  # after the setup, whose large arrays are allocated once
         self.solve_options = {"accel": opts.accel, "start": opts.start}
         #: what the problem and the solver found worth a warning (e.g. mesh problems)
-        self.warnings = mesh_warnings(mesh.vertices, mesh.triangles()[0]) + list(
-            getattr(self.deformer, "warnings", []))
+        self.warnings = mesh_notes + list(getattr(self.deformer, "warnings", []))
         self.last_result = None
 
     def run(self, frames, *, max_iter, tol, stop_unconverged=False, state=None,

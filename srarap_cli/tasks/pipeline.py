@@ -128,6 +128,9 @@ def deform_mesh(mesh: Mesh, constraints: Constraints,
         raise TypeError("deform_mesh() takes settings or keyword overrides, not both")
     opts = settings if settings is not None else resolve(constraints.solver, overrides)
     p = problem(mesh, constraints, name)
+    # before the solver exists: the checks' temporaries (edge tables of the whole mesh) then
+    # do not add to the memory it holds
+    mesh_notes = mesh_warnings(mesh.vertices, mesh.triangles()[0])
     deformer = build_deformer(p, opts, cache)
     keep_freed_memory()  # after the setup, whose large arrays are allocated once
     sub_result = deformer.solve(p.targets, callback=callback, **opts.stage("solve"))
@@ -135,5 +138,5 @@ def deform_mesh(mesh: Mesh, constraints: Constraints,
     rotors = np.tile(IDENTITY, (len(positions), 1))
     rotors[p.vertices] = sub_result.rotors
     result = replace(sub_result, positions=positions, rotors=rotors)
-    notes = mesh_warnings(mesh.vertices, mesh.triangles()[0]) + list(deformer.warnings)
+    notes = mesh_notes + list(deformer.warnings)
     return mesh.with_vertices(positions), result, notes
