@@ -19,11 +19,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..io.input_files import read_input_bytes
-from ..runtime.allocator import keep_freed_memory
 from ..runtime.errors import InputError, excerpt
-from ..solver.mesh_checks import mesh_warnings
 from ..solver.quaternion import align_hemisphere, multiply, normalize
-from .pipeline import build_deformer, problem, scatter
+from .pipeline import command_solver, problem, scatter
 
 FRAME_FIELDS = ("frame", "iterations", "membrane", "bending", "total", "converged",
                 "min_rotor_dot", "seconds")
@@ -77,13 +75,9 @@ class Animator:
         self.mesh = mesh
         self.constraints = constraints
         self.problem = problem(mesh, constraints, name)
-        # the mesh checks before the solver exists, so their temporaries do not add to it
-        mesh_notes = mesh_warnings(mesh.vertices, mesh.triangles()[0])
-        self.deformer = build_deformer(self.problem, opts, cache)
-        keep_freed_memory()  # after the setup, whose large arrays are allocated once
+        #: warnings: what the mesh checks and the solver found (e.g. mesh problems)
+        self.deformer, self.warnings = command_solver(mesh, self.problem, opts, cache)
         self.solve_options = {"accel": opts.accel, "start": opts.start}
-        #: what the problem and the solver found worth a warning (e.g. mesh problems)
-        self.warnings = mesh_notes + list(getattr(self.deformer, "warnings", []))
         self.last_result = None
 
     def run(self, frames, *, max_iter, tol, stop_unconverged=False, state=None,
