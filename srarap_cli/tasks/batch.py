@@ -221,9 +221,19 @@ def run_batch(jobs, out_dir, workers=1, scheduler=None, keep_unconverged=False):
 #: dynamic malloc trimming (Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536, which turned each
 #: solve's large temporaries into mmap/munmap pairs: system time 0.23 -> 4.5 s for 20 jobs)
 WORKER_ENVIRON = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1}
-# local workers are forked: a spawned worker imports numpy, scipy, libigl and distributed
-# again (about 1.5 s for two), which made 20 jobs of 5k vertices take 4.7 s against 3.2 s
-# with --workers 2; forked, 1.03x of --workers 2 (benchmarks/batch_speedup.py)
+#: Dask settings for the workers srarap starts. They are forked: a spawned worker imports
+#: numpy, scipy, libigl and distributed again (about 1.5 s for two), which made 20 jobs of 5k
+#: vertices take 4.7 s against 3.2 s with --workers 2. The rest wakes the workers less often:
+#: Dask's profiler samples the running task's stack every 10 ms (for a dashboard these
+#: clusters do not have), event loops tick every 20 ms, monitors poll psutil 10 times a
+#: second; on 2 cores each wake-up takes the core from a solve. With Dask's defaults a job
+#: used 5.6% more CPU time in its thread than in a --workers 2 process, with these 1%.
+LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRON,
+                "distributed.worker.multiprocessing-method": "fork",
+                "distributed.worker.profile.enabled": False,
+                "distributed.admin.tick.interval": "1s",
+                "distributed.admin.system-monitor.interval": "5s",
+                "distributed.worker.memory.monitor-interval": "1s"}
 
 
 def _run_on_dask(jobs, run, scheduler, workers):
@@ -235,8 +245,7 @@ def _run_on_dask(jobs, run, scheduler, workers):
     except ImportError:
         raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
     run = functools.partial(run, out_dir=os.path.abspath(run.keywords["out_dir"]))
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": WORKER_ENVIRON,
-                          "distributed.worker.multiprocessing-method": "fork"}):
+    with dask.config.set(LOCAL_CONFIG):
         cluster = None
         if scheduler == "local":
             with _without_dasks_trim_setting():
