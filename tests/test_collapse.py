@@ -3,7 +3,7 @@ import igl
 import numpy as np
 import pytest
 
-from srarap_cli.solver.multires.collapse import collapse_to
+from srarap_cli.solver.multires.collapse import PASSES, _independent, _Rings, collapse_to
 from srarap_cli.solver.multires.simplify import _octahedron
 from srarap_cli.solver.multires.topology import topology_summary
 
@@ -85,3 +85,45 @@ def test_no_part_of_the_surface_vanishes_whole():
     assert np.unique(G[G.max(axis=1) < len(V)]).size <= 30
     Vs, Fs = soup(V, F)
     assert np.array_equal(collapse_to(Vs, Fs, 30, np.zeros(len(Vs), bool)), Fs)
+
+
+def _rings_of(F, n):
+    ring = [{i} for i in range(n)]
+    for a, b, c in F:
+        for x, y in ((a, b), (b, c), (c, a)):
+            ring[x].add(y)
+            ring[y].add(x)
+    return ring
+
+
+def _independent_by_pairs(ring, u, v):
+    """The passes of ``_independent`` written out pair by pair (proposals in rank order)."""
+    def interfere(i, j):
+        return bool({u[j], v[j]} & ring[u[i]] or {u[i], v[i]} & ring[u[j]])
+
+    won = []
+    for _ in range(PASSES):
+        open_ = [i for i in range(len(u))
+                 if i not in won and not any(interfere(i, w) for w in won)]
+        new = [i for i in open_ if not any(interfere(i, j) for j in open_ if j < i)]
+        if not open_:
+            break
+        won += new
+    return sorted(won)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_independent_collapses_match_the_pairwise_rule_and_share_no_ring(seed):
+    rng = np.random.default_rng(seed)
+    V, F = grid(9)
+    n = len(V)
+    ring = _rings_of(F, n)
+    u = rng.permutation(n)[:40]
+    v = np.array([rng.choice(sorted(ring[x] - {x})) for x in u])
+    edges = np.unique(np.sort(np.vstack([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1),
+                      axis=0)
+    won = _independent(_Rings(edges, F, n), u, v, n)
+    assert won.tolist() == _independent_by_pairs(ring, u, v)
+    for a in won:
+        for b in won:
+            assert a == b or not ({u[b], v[b]} & ring[u[a]])

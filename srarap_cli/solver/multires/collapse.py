@@ -142,31 +142,64 @@ def _independent(rings, u, v, n):
     sorted by priority. Two collapses interfere when one's u or v lies in the other's closed
     one-ring N[u] (that ring's faces, neighbours and link are what the other changes). A
     proposal wins where no better one touches its ring and no better ring holds its u or v;
-    the passes repeat this among proposals clear of the winners."""
-    owner, member = rings.closed(u)
-    touch_owner = np.tile(np.arange(u.size), 2)
-    touch = np.concatenate([u, v])
-    won = np.zeros(u.size, dtype=bool)
+    the passes repeat this among proposals clear of the winners.
+
+    Each pass works on the proposals still open (neither won nor touched by a winner: the
+    taken vertices only grow, so a touched proposal stays out), indexed by rank among them;
+    the rings are u itself plus its neighbours, one non-empty run per proposal."""
+    owner, member = _segments(rings.nbr_ptr, rings.nbr, u)
+    open_, cu, cv = np.arange(u.size), u, v
+    starts = _run_starts(owner, u.size)
     ring_taken = np.zeros(n, dtype=bool)
     touch_taken = np.zeros(n, dtype=bool)
+    won = []
     for _ in range(PASSES):
-        hit = (_any(owner, touch_taken[member], u.size)
-               | _any(touch_owner, ring_taken[touch], u.size))
-        live = ~won & ~hit
-        if not live.any():
+        hit = (touch_taken[cu] | ring_taken[cu] | ring_taken[cv]
+               | _runs_any(touch_taken[member], starts))
+        if hit.any():
+            open_, cu, cv, owner, member, starts = _keep(~hit, open_, cu, cv, owner, member,
+                                                         starts)
+        k = open_.size
+        if not k:
             break
-        prio = np.where(live, np.arange(u.size), u.size)
-        best_ring = np.full(n, u.size)
-        np.minimum.at(best_ring, member, prio[owner])
-        best_touch = np.full(n, u.size)
-        np.minimum.at(best_touch, touch, prio[touch_owner])
-        lost = (_any(owner, best_touch[member] < prio[owner], u.size)
-                | _any(touch_owner, best_ring[touch] < prio[touch_owner], u.size))
-        new = live & ~lost
-        won |= new
+        rank = np.arange(k)
+        best_ring = np.full(n, k)
+        best_ring[cu] = rank
+        np.minimum.at(best_ring, member, owner)
+        best_touch = np.full(n, k)
+        best_touch[cu] = rank
+        np.minimum.at(best_touch, cv, rank)
+        lost = ((best_touch[cu] < rank) | (best_ring[cu] < rank) | (best_ring[cv] < rank)
+                | _runs_any(best_touch[member] < owner, starts))
+        new = ~lost
+        won.append(open_[new])
+        ring_taken[cu[new]] = True
         ring_taken[member[new[owner]]] = True
-        touch_taken[touch[new[touch_owner]]] = True
-    return np.flatnonzero(won)
+        touch_taken[cu[new]] = True
+        touch_taken[cv[new]] = True
+        open_, cu, cv, owner, member, starts = _keep(lost, open_, cu, cv, owner, member, starts)
+    return np.sort(np.concatenate(won)) if won else np.empty(0, dtype=np.int64)
+
+
+def _run_starts(owner, size):
+    """Where each owner's run begins in the sorted ``owner`` (every owner has a run)."""
+    return np.searchsorted(owner, np.arange(size))
+
+
+def _runs_any(flags, starts):
+    """Per run (beginning at ``starts``, none empty), whether any of its flags is set."""
+    if not starts.size:
+        return np.zeros(0, dtype=bool)
+    return np.logical_or.reduceat(flags, starts)
+
+
+def _keep(keep, open_, cu, cv, owner, member, starts):
+    """The open proposals (and their ring runs) where ``keep``, re-ranked from 0."""
+    lengths = np.diff(starts, append=owner.size)
+    member = member[np.repeat(keep, lengths)]
+    lengths = lengths[keep]
+    owner = np.repeat(np.arange(lengths.size), lengths)
+    return open_[keep], cu[keep], cv[keep], owner, member, np.cumsum(lengths) - lengths
 
 
 def _any(owner, flags, size):
@@ -223,11 +256,6 @@ class _Rings:
                                       np.concatenate([edges[:, 0], edges[:, 1]]), n)
         self.keys = np.repeat(np.arange(n), np.diff(self.nbr_ptr)) * n + self.nbr
         self.face_ptr, self.face = _csr(F.ravel(), np.repeat(np.arange(len(F)), 3), n)
-
-    def closed(self, u):
-        """(owner, member) pairs: member runs over u[owner] and its neighbours."""
-        owner, member = _segments(self.nbr_ptr, self.nbr, u)
-        return np.concatenate([np.arange(u.size), owner]), np.concatenate([u, member])
 
     def star(self, u):
         """(owner, face) pairs: the triangles around u[owner]."""
