@@ -64,13 +64,15 @@ def collapse_to(V, F, size, frozen):
     lifted = _lifted(V)
     alive = np.unique(F).size
     banned = np.empty(0, dtype=np.int64)
+    best = _Best(len(V))
     while alive > size:
-        u, v, invalid = _round(V, lifted, surface, F, Q, frozen, banned, alive - size)
+        u, v, invalid = _round(V, lifted, surface, F, Q, frozen, banned, alive - size, best)
         if not u.size:
             if not banned.size:
                 break
             # proposals found invalid earlier may have become valid since
             banned = np.empty(0, dtype=np.int64)
+            best.dirty[:] = True
             continue
         banned = np.union1d(banned, invalid)
         Q[v] += Q[u]
@@ -82,9 +84,10 @@ def collapse_to(V, F, size, frozen):
     return F
 
 
-def _round(V, lifted, surface, F, Q, frozen, banned, need):
+def _round(V, lifted, surface, F, Q, frozen, banned, need, best):
     """One round: the vertices to delete, the vertices they collapse into, and the keys
     (u n + v) of proposals that won but failed the checks (left out of later rounds).
+    ``best`` (a :class:`_Best`) keeps each vertex's proposal between rounds.
 
     Checks run only on the winners: most proposals pass them, and checking every vertex's
     proposal each round cost several times the rest of the round."""
@@ -97,12 +100,14 @@ def _round(V, lifted, surface, F, Q, frozen, banned, need):
     u = np.concatenate([edges[:, 0], edges[:, 1]])
     v = np.concatenate([edges[:, 1], edges[:, 0]])
     c = np.concatenate([count, count])
+    redo = best.dirty[u]
+    u, v, c = u[redo], v[redo], c[redo]
     # a border vertex may only slide along the border, so boundaries keep their shape
     ok = ~fixed[u] & (c <= 2) & (~border[u] | (c == 1)) & ~_isin_sorted(u * n + v, banned)
     u, v, c = u[ok], v[ok], c[ok]
     cost = _costs(Q, lifted, u, v)
     first = _cheapest_per_vertex(u, v, cost, n)
-    u, v, c, cost = u[first], v[first], c[first], cost[first]
+    u, v, c, cost = best.update(u[first], v[first], c[first], cost[first])
     if u.size > 1:
         keep = cost <= np.quantile(cost, CHEAPEST)
         u, v, c, cost = u[keep], v[keep], c[keep], cost[keep]
@@ -114,8 +119,44 @@ def _round(V, lifted, surface, F, Q, frozen, banned, need):
     good = (rings.link_ok(u, v, c) & rings.keeps_a_face(u, c)
             & _keeps_shape(V, surface, rings, u, v))
     invalid = u[~good] * n + v[~good]
+    best.changed(rings, u[~good], u[good][:need], v[good][:need])
     u, v = u[good][:need], v[good][:need]
     return u, v, invalid
+
+
+class _Best:
+    """Each vertex's cheapest valid collapse, kept between rounds.
+
+    A vertex's proposals depend on its ring alone: its triangles, its neighbours, their
+    quadrics and its own, the banned keys. A collapse u -> v changes only the triangles,
+    neighbours and quadrics of vertices in the closed rings of u and v, and a winner that
+    failed its checks only its own proposal; everywhere else last round's cheapest collapse
+    is still the cheapest, at the same cost. The share priced again grows from a fifth to
+    four fifths of the vertices over the rounds (738k vertices: 5.8 -> 3.6 s of pricing)."""
+
+    def __init__(self, n):
+        self.v = np.zeros(n, dtype=np.int64)
+        self.c = np.zeros(n, dtype=np.int64)
+        self.cost = np.zeros(n)
+        self.has = np.zeros(n, dtype=bool)
+        self.dirty = np.ones(n, dtype=bool)
+
+    def update(self, u, v, c, cost):
+        """Record the proposals of the dirty vertices (the cheapest of each, ``u``
+        increasing); returns every vertex's proposal (u, v, c, cost), u increasing."""
+        self.has[self.dirty] = False
+        self.has[u], self.v[u], self.c[u], self.cost[u] = True, v, c, cost
+        u = np.flatnonzero(self.has)
+        return u, self.v[u], self.c[u], self.cost[u]
+
+    def changed(self, rings, failed, u, v):
+        """After a round that applies u -> v and bans the proposals of ``failed``: what
+        must be priced again."""
+        self.dirty[:] = False
+        self.dirty[failed] = True
+        for ends in (u, v):
+            self.dirty[ends] = True
+            self.dirty[_segments(rings.nbr_ptr, rings.nbr, ends)[1]] = True
 
 
 def _cheapest_per_vertex(u, v, cost, n):
