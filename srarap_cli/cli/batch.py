@@ -21,7 +21,7 @@ from .common import guarded
               "'local' starts --workers single-threaded worker processes here; an address "
               "('tcp://host:8786') uses that cluster, whose workers must share this file "
               "system and should run one thread each (dask worker --nthreads 1) with "
-              "OPENBLAS_NUM_THREADS=1 and without MALLOC_TRIM_THRESHOLD_ set.")
+              "OPENBLAS_NUM_THREADS=1 and Dask's profiler off (see the workflows guide).")
 @click.option("-o", "--output", "out", default=".", show_default=True,
               help="Folder for the jobs' outputs and summary.csv / summary.json.")
 @click.option("--keep-unconverged", is_flag=True,
