@@ -98,9 +98,12 @@ def test_a_dask_cluster_gives_the_same_results_as_local_workers(tmp_path):
 
 def test_scheduler_local_starts_single_threaded_workers_without_dasks_trim_setting(tmp_path):
     """``--scheduler local``: the same bytes as local workers; its workers run one BLAS
-    thread and glibc's own malloc trimming (Dask's nanny default slowed solves 1.8x)."""
+    thread and glibc's own malloc trimming (Dask's nanny default slowed solves 1.8x), without
+    Dask's statistical profiler (its samples took CPU from the solves)."""
     import functools
     import os
+
+    import dask
 
     from srarap_cli.tasks.batch import _run_on_dask
 
@@ -111,10 +114,11 @@ def test_scheduler_local_starts_single_threaded_workers_without_dasks_trim_setti
     assert dask_run.exit_code == 0, dask_run.output
     assert (tmp_path / "dask" / "twist.obj").read_bytes() == \
         (tmp_path / "local" / "twist.obj").read_bytes()
-    probe = functools.partial(lambda job, out_dir: (os.environ.get("MALLOC_TRIM_THRESHOLD_"),
-                                                     os.environ.get("OPENBLAS_NUM_THREADS")),
-                              out_dir=str(tmp_path))
-    assert _run_on_dask([{}, {}], probe, "local", 2) == [(None, "1"), (None, "1")]
+    probe = functools.partial(lambda job, out_dir: (
+        os.environ.get("MALLOC_TRIM_THRESHOLD_"), os.environ.get("OPENBLAS_NUM_THREADS"),
+        dask.config.get("distributed.worker.profile.enabled")), out_dir=str(tmp_path))
+    assert _run_on_dask([{}, {}], probe, "local", 2) == [(None, "1", False)] * 2
+    assert dask.config.get("distributed.worker.profile.enabled")  # this process: as it was
 
 
 def test_editing_a_file_the_handle_file_names_makes_the_job_run_again(tmp_path):
