@@ -227,7 +227,7 @@ WORKER_ENVIRON = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THRE
 #: Dask's profiler samples the running task's stack every 10 ms (for a dashboard these
 #: clusters do not have), event loops tick every 20 ms, monitors poll psutil 10 times a
 #: second; on 2 cores each wake-up takes the core from a solve. With Dask's defaults a job
-#: used 5.6% more CPU time in its thread than in a --workers 2 process, with these 1%.
+#: used 5.6% more CPU time in its thread than in a --workers 2 process; with these settings, 1%.
 LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRON,
                 "distributed.worker.multiprocessing-method": "fork",
                 "distributed.worker.profile.enabled": False,
