@@ -362,9 +362,9 @@ def _border_quadrics(V, F, unit, n):
     a = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
     b = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
     face = np.tile(np.arange(len(F)), 3)
-    key = np.minimum(a, b) * n + np.maximum(a, b)
-    _, inverse, count = np.unique(key, return_inverse=True, return_counts=True)
-    lone = count[inverse] == 1
+    edges, count = edge_counts(F)
+    lone_keys = edges[count == 1, 0] * n + edges[count == 1, 1]  # sorted, as the edges
+    lone = _isin_sorted(np.minimum(a, b) * n + np.maximum(a, b), lone_keys)
     a, b, face = a[lone], b[lone], face[lone]
     along = V[b] - V[a]
     length2 = np.einsum("ij,ij->i", along, along)
