@@ -245,19 +245,19 @@ def _run_on_dask(jobs, run, scheduler, workers):
     except ImportError:
         raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
     run = functools.partial(run, out_dir=os.path.abspath(run.keywords["out_dir"]))
-    with dask.config.set(LOCAL_CONFIG):
-        cluster = None
-        if scheduler == "local":
-            with _without_dasks_trim_setting():
-                cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
-                                       processes=True, dashboard_address=None)
-        try:
-            return _gather(Client(cluster or scheduler, timeout=30), jobs, run)
-        except (OSError, TimeoutError) as exc:
-            raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
-        finally:
-            if cluster is not None:
-                cluster.close()
+    cluster = None
+    if scheduler == "local":
+        # the workers are forked while the cluster starts: they keep these settings
+        with dask.config.set(LOCAL_CONFIG), _without_dasks_trim_setting():
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+    try:
+        return _gather(Client(cluster or scheduler, timeout=30), jobs, run)
+    except (OSError, TimeoutError) as exc:
+        raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+    finally:
+        if cluster is not None:
+            cluster.close()
 
 
 @contextlib.contextmanager

@@ -190,7 +190,8 @@ def _independent(rings, u, v, n):
     the rings are u itself plus its neighbours, one non-empty run per proposal."""
     owner, member = _segments(rings.nbr_ptr, rings.nbr, u)
     open_, cu, cv = np.arange(u.size), u, v
-    starts = _run_starts(owner, u.size)
+    lengths = rings.nbr_ptr[u + 1] - rings.nbr_ptr[u]
+    starts = np.cumsum(lengths) - lengths
     ring_taken = np.zeros(n, dtype=bool)
     touch_taken = np.zeros(n, dtype=bool)
     won = []
@@ -220,11 +221,6 @@ def _independent(rings, u, v, n):
         touch_taken[cv[new]] = True
         open_, cu, cv, owner, member, starts = _keep(lost, open_, cu, cv, owner, member, starts)
     return np.sort(np.concatenate(won)) if won else np.empty(0, dtype=np.int64)
-
-
-def _run_starts(owner, size):
-    """Where each owner's run begins in the sorted ``owner`` (every owner has a run)."""
-    return np.searchsorted(owner, np.arange(size))
 
 
 def _runs_any(flags, starts):
