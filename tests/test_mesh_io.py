@@ -89,31 +89,6 @@ def test_output_bytes_are_deterministic(tmp_path):
             os.path.join(ROOT, "sample_meshes", "spot.obj")), suffix)[0]
 
 
-@pytest.mark.parametrize("newline", ["\n", "\r\n"])
-def test_bulk_obj_reading_and_writing_match_the_line_by_line_ones(newline):
-    """Plain v/f files take a bulk path both ways; it must give what the general one does."""
-    from srarap_cli.io.mesh import obj
-
-    spot = read_mesh(os.path.join(ROOT, "sample_meshes", "spot.obj"))
-    spot.uv = spot.face_uv = spot.normals = spot.face_normals = None
-    text = format_mesh(spot, ".obj")[0].decode()
-    text = ("# a comment\n\n" + text + "\n  \n").replace("\n", newline)
-    bulk, general = obj._read_plain(text), obj._read_general(text, "spot.obj")
-    assert bulk is not None
-    assert np.array_equal(bulk.vertices, general.vertices)
-    same_structure(bulk, general)
-    assert bulk.statements == general.statements == []
-    lines = "".join(line + "\n" for line in obj._face_lines(bulk))
-    assert obj._face_block(bulk) == lines
-    square = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
-    mixed = obj._read_plain(square + "f 1 2 4 3\nf 1 2 3\n")
-    assert mixed.face_sizes.tolist() == [4, 3] and obj._face_block(mixed) is None
-    # anything else goes line by line: a named object, corners with uv ids, negative ids,
-    # a 4-number vertex
-    for other in ("o x\nf 1 2 3\n", "f 1/1 2/2 3/3\n", "f -1 -2 -3\n", "v 0 0 0 1\nf 1 2 3\n"):
-        assert obj._read_plain(square + other) is None
-
-
 @needs_shared
 def test_every_shared_mesh_reads_with_its_vertex_count():
     assert os.path.isdir(SHARED), "the tests expect ../shared/meshes beside the repository"

@@ -1,0 +1,126 @@
+"""The OBJ reader's and writer's bulk paths against the line-by-line ones and a reference
+writer written out here, corner by corner."""
+import os
+
+import numpy as np
+import pytest
+from helpers import ROOT
+
+from srarap_cli.io.mesh import obj, read_mesh
+
+FIELDS = ("vertices", "face_sizes", "face_vertices", "uv", "face_uv", "normals",
+          "face_normals")
+SQUARE = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nvn 0 0 -1\n"
+
+
+def assert_same_mesh(a, b):
+    for name in FIELDS:
+        x, y = getattr(a, name), getattr(b, name)
+        assert (x is None) == (y is None), name
+        if x is not None:
+            assert x.dtype == y.dtype and np.array_equal(x, y), name
+    assert a.statements == b.statements
+
+
+def reference_obj(mesh):
+    """OBJ text the slow way: one polygon, one corner at a time."""
+    def number(x):
+        return f"{x:.17g}"
+    later = {}
+    for k, s in mesh.statements:
+        later.setdefault(k, []).append(s + "\n")
+    out = ["# written by srarap\n", *later.get(0, [])]
+    out += ["v " + " ".join(map(number, p)) + "\n" for p in mesh.vertices]
+    if mesh.uv is not None:
+        out += ["vt " + " ".join(map(number, p)) + "\n" for p in mesh.uv]
+    if mesh.normals is not None:
+        out += ["vn " + " ".join(map(number, p)) + "\n" for p in mesh.normals]
+    corner = 0
+    for f, size in enumerate(mesh.face_sizes, 1):
+        tokens = []
+        for c in range(corner, corner + size):
+            t = -1 if mesh.face_uv is None else mesh.face_uv[c]
+            n = -1 if mesh.face_normals is None else mesh.face_normals[c]
+            tok = str(mesh.face_vertices[c] + 1)
+            if t >= 0 or n >= 0:
+                tok += "/" + (str(t + 1) if t >= 0 else "")
+            if n >= 0:
+                tok += "/" + str(n + 1)
+            tokens.append(tok)
+        corner += size
+        out.append("f " + " ".join(tokens) + "\n")
+        out += later.get(f, [])
+    return "".join(out)
+
+
+# (faces, whether the bulk reader takes them): every corner form, statements among faces,
+# and what must go line by line: mixed forms (one corner "1/1/1" and one "2" hold two
+# slashes for two corners, as two "v/t" corners would), negative ids, out-of-range ids,
+# leading blanks, a bare head, a 4-number vertex
+CASES = [
+    ("f 1 2 3\nf 2 4 3\n", True),
+    ("f 1/1 2/2 3/3\nf 2/2 4/1 3/3\n", True),
+    ("f 1//1 2//1 3//2\n", True),
+    ("f 1/1/1 2/2/1 3/3/2 4/1/1\n", True),
+    ("o thing\nusemtl red\nf 1/1 2/2 3/3\ns off\nusemtl blue\nf 2/2 4/1 3/3\ng end\n", True),
+    ("f 1 2 3 4\nf 1 2 3\n", True),
+    ("# lead\n\nf 1 2 3\n   \n# tail\n", True),
+    ("f 1/1/1 2 3/3\n", False),
+    ("f 1/1/1 2 3/3/1 4/2\n", False),
+    ("f 1//1 2/2/ 3/3/1\n", False),
+    ("f 1/ 2/2 3/3\n", False),
+    ("f -1 -2 -3\n", False),
+    ("f 1/4 2/2 3/3\n", False),
+    ("f 1//3 2//1 3//1\n", False),
+    ("f 1 2 5\n", False),
+    ("f 1.5 2 3\n", False),
+    ("  f 1 2 3\n", False),
+    ("o\nv\n", False),
+    ("v 0 0 0 1\nf 1 2 3\n", False),
+    ("f 1 2\n", False),
+]
+
+
+@pytest.mark.parametrize("newline", ["\n", "\r\n"])
+@pytest.mark.parametrize("faces, bulk", CASES)
+def test_bulk_reader_reads_what_the_line_by_line_reader_reads(faces, bulk, newline):
+    text = (SQUARE + faces).replace("\n", newline)
+    fast = obj._read_bulk(text)
+    assert (fast is not None) == bulk
+    if fast is not None:
+        assert_same_mesh(fast, obj._read_general(text, "t.obj"))
+
+
+def test_line_breaks_other_than_newline_go_line_by_line():
+    for odd in ("\r", "\x0c", "\u2028"):
+        assert obj._read_bulk(SQUARE + "f 1 2 3" + odd + "f 2 4 3\n") is None
+
+
+@pytest.mark.parametrize("faces, bulk", [c for c in CASES if c[1]])
+def test_writer_matches_the_corner_by_corner_reference(faces, bulk):
+    mesh = obj._read_bulk(SQUARE + faces)
+    assert obj.format_obj(mesh) == reference_obj(mesh)
+
+
+def test_writer_handles_mixed_sizes_forms_and_alternation():
+    spot = read_mesh(os.path.join(ROOT, "sample_meshes", "spot.obj"))
+    assert obj.format_obj(spot) == reference_obj(spot)
+    # some corners without normal ids, statements among the polygons; then polygon sizes
+    # alternating every polygon, then in long runs
+    spot.face_normals[::7] = -1
+    spot.statements = [(0, "o cow"), (100, "usemtl a"), (100, "s 1"), (spot.face_sizes.size,
+                                                                         "g end")]
+    assert obj.format_obj(spot) == reference_obj(spot)
+    quads = obj._read_bulk(SQUARE + "f 1/1 2/2 4/1 3/3\nf 1/1 2/2 3/3\n" * 3
+                           + "f 1/1 2/2 3/3\n" * 200 + "f 1/1 2/2 4/1 3/3\n" * 200)
+    assert obj.format_obj(quads) == reference_obj(quads)
+
+
+def test_sample_mesh_takes_the_bulk_path_and_round_trips():
+    path = os.path.join(ROOT, "sample_meshes", "spot.obj")
+    with open(path) as fh:
+        text = fh.read()
+    fast = obj._read_bulk(text)
+    assert fast is not None and fast.normals is not None
+    assert_same_mesh(fast, obj._read_general(text, path))
+    assert_same_mesh(obj._read_bulk(obj.format_obj(fast)), fast)
