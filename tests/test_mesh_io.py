@@ -189,3 +189,19 @@ def test_ascii_stl_welds_shared_corners_and_keeps_its_name_tokens(tmp_path):
     mesh = read_mesh(str(path))
     assert mesh.vertices.tolist() == [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]
     assert mesh.face_vertices.tolist() == [0, 1, 2, 1, 3, 2]
+
+
+@pytest.mark.parametrize("sizes", [[3, 3, 3], [4, 4], [3, 4, 5]])
+def test_ply_face_records_are_a_count_byte_then_int32_ids(sizes):
+    import struct
+
+    from srarap_cli.io.mesh.mesh import Mesh
+    from srarap_cli.io.mesh.ply import _face_bytes
+    ids = np.arange(sum(sizes)) * 7919 % 100_003
+    mesh = Mesh(vertices=np.zeros((100_003, 3)), face_sizes=np.array(sizes),
+                face_vertices=ids)
+    expected, at = b"", 0
+    for k in sizes:
+        expected += struct.pack(f"<B{k}i", k, *ids[at:at + k].tolist())
+        at += k
+    assert _face_bytes(mesh) == expected

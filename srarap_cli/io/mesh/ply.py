@@ -65,6 +65,12 @@ def _ascii_rows(table, mesh):
 def _face_bytes(mesh):
     """Each polygon as a uint8 corner count followed by int32 vertex ids."""
     sizes = mesh.face_sizes
+    if sizes.size and (sizes == sizes[0]).all():  # one record type: no scatter (1.2 -> 0.1 s)
+        k = int(sizes[0])
+        table = np.empty(sizes.size, dtype=[("n", "u1"), ("ids", "<i4", (k,))])
+        table["n"] = k
+        table["ids"] = mesh.face_vertices.reshape(-1, k)
+        return table.tobytes()
     start = np.concatenate([[0], np.cumsum(1 + 4 * sizes)[:-1]]).astype(np.int64)
     buf = np.zeros(int((1 + 4 * sizes).sum()), dtype=np.uint8)
     buf[start] = sizes.astype(np.uint8)
