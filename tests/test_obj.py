@@ -111,6 +111,9 @@ def test_writer_handles_mixed_sizes_forms_and_alternation():
     spot.statements = [(0, "o cow"), (100, "usemtl a"), (100, "s 1"), (spot.face_sizes.size,
                                                                          "g end")]
     assert obj.format_obj(spot) == reference_obj(spot)
+    for every in (1, 3, 10):  # statements every few polygons: line by line, then blocks
+        spot.statements = [(k, f"s {k}") for k in range(0, spot.face_sizes.size, every)]
+        assert obj.format_obj(spot) == reference_obj(spot)
     quads = obj._read_bulk(SQUARE + "f 1/1 2/2 4/1 3/3\nf 1/1 2/2 3/3\n" * 3
                            + "f 1/1 2/2 3/3\n" * 200 + "f 1/1 2/2 4/1 3/3\n" * 200)
     assert obj.format_obj(quads) == reference_obj(quads)

@@ -205,8 +205,7 @@ def _face_lines(mesh, offsets, first, stop):
     tok = np.where(n >= 0, np.where(t >= 0, tok, tok + "/") + "/"
                    + (n + 1).astype(str).astype(object), tok)
     ends = offsets[first:stop + 1] - offsets[first]
-    return "".join("f " + " ".join(tok[ends[i]:ends[i + 1]]) + "\n"
-                   for i in range(stop - first))
+    return ["f " + " ".join(tok[ends[i]:ends[i + 1]]) + "\n" for i in range(stop - first)]
 
 
 _CORNER_FORMS = {(False, False): "%d", (True, False): "%d/%d", (False, True): "%d//%d",
@@ -243,12 +242,15 @@ def format_obj(mesh):
         parts.append(_rows("vt" + " %.17g" * mesh.uv.shape[1] + "\n", mesh.uv))
     if mesh.normals is not None:
         parts.append(_rows("vn %.17g %.17g %.17g\n", mesh.normals))
-    # faces in runs between the statements among them (usemtl, g, s, ...)
-    offsets = mesh.face_offsets
-    bounds = [0, *sorted(later), mesh.face_sizes.size]
+    # faces in runs between the statements among them (usemtl, g, s, ...); when those come
+    # every few faces, blocks would cost more than one pass line by line
+    offsets, count = mesh.face_offsets, mesh.face_sizes.size
+    bounds = [0, *sorted(later), count]
+    lines = _face_lines(mesh, offsets, 0, count) if 8 * len(bounds) > count else None
     for first, stop in zip(bounds, bounds[1:]):
         parts.extend(later.get(first, ()))
-        parts.extend(_face_text(mesh, offsets, first, stop))
+        parts.extend(lines[first:stop] if lines is not None
+                     else _face_text(mesh, offsets, first, stop))
     return "".join(parts)
 
 
@@ -258,7 +260,10 @@ def _face_text(mesh, offsets, first, stop):
     blocks to pay or the corners' forms differ."""
     changes = first + 1 + np.flatnonzero(np.diff(mesh.face_sizes[first:stop]))
     if 64 * changes.size > stop - first:
-        return [_face_lines(mesh, offsets, first, stop)]
+        return _face_lines(mesh, offsets, first, stop)
     bounds = [first, *changes.tolist(), stop]
-    return [_face_block(mesh, offsets, a, b) or _face_lines(mesh, offsets, a, b)
-            for a, b in zip(bounds, bounds[1:]) if b > a]
+    out = []
+    for a, b in zip(bounds, bounds[1:]):
+        block = _face_block(mesh, offsets, a, b) if b > a else ""
+        out.extend([block] if block is not None else _face_lines(mesh, offsets, a, b))
+    return out
