@@ -80,5 +80,6 @@ def test_glued_tori_have_pinched_vertices():
 def test_double_cone_apex_is_reported():
     F, n = double_cone()
     assert fans_per_vertex(F, n)[0] == 2
+    assert fans_per_vertex(np.zeros((0, 3), int), 2).tolist() == [0, 0]  # (libigl: bad_alloc)
     V = np.random.default_rng(0).normal(size=(n, 3))
     assert any("1 non-manifold vertices" in w for w in mesh_warnings(V, F))

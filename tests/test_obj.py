@@ -119,6 +119,12 @@ def test_writer_handles_mixed_sizes_forms_and_alternation():
     assert obj.format_obj(quads) == reference_obj(quads)
 
 
+def test_statements_said_to_follow_missing_faces_are_written_last():
+    mesh = obj._read_bulk(SQUARE + "f 1 2 3\ng end\n")
+    mesh.statements.append((5, "g beyond"))
+    assert obj.format_obj(mesh).endswith("f 1 2 3\ng end\ng beyond\n")
+
+
 def test_sample_mesh_takes_the_bulk_path_and_round_trips():
     path = os.path.join(ROOT, "sample_meshes", "spot.obj")
     with open(path) as fh:

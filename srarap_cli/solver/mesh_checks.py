@@ -151,8 +151,9 @@ def _manifold_warnings(F, n, counts):
 
 def fans_per_vertex(F, n):
     """How many fans the faces around each vertex form: groups of faces joined through the
-    edges at the vertex (libigl's ``is_vertex_manifold`` is a count of one; this is five
-    times faster on a million vertices, as sparse products instead of per-vertex lists).
+    edges at the vertex. A vertex is manifold (libigl's ``is_vertex_manifold``) when the
+    count is one; this count takes one sparse matrix and one connected-components pass, four
+    to six times faster than libigl on a million vertices.
 
     Each side of a corner, the directed edge from the corner's vertex to one of its face's
     other two, is a node; the two sides of a corner are linked, and equal sides are one node,
@@ -175,6 +176,8 @@ def fans_per_vertex(F, n):
     """
     F = np.asarray(F, dtype=np.int64).reshape(-1, 3)
     corner, k = F.ravel(), F.size
+    if not k:
+        return np.zeros(n, dtype=np.int64)
     rows = np.concatenate([corner, corner])
     cols = np.concatenate([F[:, [1, 2, 0]].ravel(), F[:, [2, 0, 1]].ravel()])
     sides = sp.csr_matrix((np.ones(rows.size, dtype=np.int64), (rows, cols)), shape=(n, n))

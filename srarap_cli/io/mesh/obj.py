@@ -233,9 +233,9 @@ def _face_block(mesh, offsets, first, stop):
 
 def format_obj(mesh):
     """OBJ text for ``mesh``: deterministic, coordinates with 17 significant digits."""
-    later = {}
-    for k, s in mesh.statements:
-        later.setdefault(k, []).append(s + "\n")
+    later, count = {}, mesh.face_sizes.size
+    for k, s in mesh.statements:  # one said to follow more faces than there are goes last
+        later.setdefault(min(k, count), []).append(s + "\n")
     parts = ["# written by srarap\n", *later.pop(0, ())]
     parts.append(_rows("v %.17g %.17g %.17g\n", mesh.vertices))
     if mesh.uv is not None:
@@ -244,7 +244,7 @@ def format_obj(mesh):
         parts.append(_rows("vn %.17g %.17g %.17g\n", mesh.normals))
     # faces in runs between the statements among them (usemtl, g, s, ...); when those come
     # every few faces, blocks would cost more than one pass line by line
-    offsets, count = mesh.face_offsets, mesh.face_sizes.size
+    offsets = mesh.face_offsets
     bounds = [0, *sorted(later), count]
     lines = _face_lines(mesh, offsets, 0, count) if 8 * len(bounds) > count else None
     for first, stop in zip(bounds, bounds[1:]):
