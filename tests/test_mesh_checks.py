@@ -1,11 +1,14 @@
 """Fans around each vertex (non-manifold vertices) against a per-vertex union-find written out
-here and against libigl's ``is_vertex_manifold``."""
+here and against libigl's ``is_vertex_manifold``; the one-way edge adjacency against the
+symmetric one."""
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from helpers import torus, tube_mesh
 
+from srarap_cli.solver.group_rotations import connected_groups
 from srarap_cli.solver.libigl import igl
-from srarap_cli.solver.mesh_checks import fans_per_vertex, mesh_warnings, solvable_faces
+from srarap_cli.solver.mesh_checks import edge_adjacency, fans_per_vertex, mesh_warnings, solvable_faces
 
 
 def root(group, i):
@@ -83,3 +86,16 @@ def test_double_cone_apex_is_reported():
     assert fans_per_vertex(np.zeros((0, 3), int), 2).tolist() == [0, 0]  # (libigl: bad_alloc)
     V = np.random.default_rng(0).normal(size=(n, 3))
     assert any("1 non-manifold vertices" in w for w in mesh_warnings(V, F))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_one_way_adjacency_groups_handles_as_the_symmetric_one(seed):
+    """Patches of random vertex subsets: an edge between two chosen vertices whose third face
+    vertex is not chosen must still join them."""
+    F, n = glued(seed)
+    both = sp.csr_matrix((np.ones(2 * F.size), (np.r_[F.ravel(), F[:, [1, 2, 0]].ravel()],
+                                                 np.r_[F[:, [1, 2, 0]].ravel(), F.ravel()])),
+                         shape=(n, n))
+    ids = np.sort(np.random.default_rng(seed).choice(n, size=n // 3, replace=False))
+    assert np.array_equal(connected_groups(edge_adjacency(F, n), ids),
+                          connected_groups(both, ids))

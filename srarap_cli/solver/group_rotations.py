@@ -61,7 +61,8 @@ def connected_groups(adjacency, ids):
 
     Parameters
     ----------
-    adjacency : (n, n) sparse matrix, nonzero where vertices share an edge
+    adjacency : (n, n) sparse matrix, nonzero (one direction is enough) where vertices share
+        an edge
     ids : (k,) int array
 
     Returns
