@@ -7,6 +7,7 @@ import pytest
 from helpers import ROOT
 
 from srarap_cli.io.mesh import obj, read_mesh
+from srarap_cli.runtime.errors import InputError
 
 FIELDS = ("vertices", "face_sizes", "face_vertices", "uv", "face_uv", "normals",
           "face_normals")
@@ -89,6 +90,29 @@ def test_bulk_reader_reads_what_the_line_by_line_reader_reads(faces, bulk, newli
     assert (fast is not None) == bulk
     if fast is not None:
         assert_same_mesh(fast, obj._read_general(text, "t.obj"))
+
+
+@pytest.mark.parametrize("text, bulk", [
+    ("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n", True),  # colours
+    ("v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\nf 1 3 2\n", True),  # vertices among faces
+    ("v 0 0 0\nvt 0 0 1\nvt 1 0 0.5\nv 1 0 0\nv 0 1 0\nf 1/1 2/2 3/1\n", True),
+    ("v 0 0 0\nv 1 0 0\n# three\nv 0 1 0\nf 1 2 3\n", True),
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0\nvt 1\nf 1/1 2/2 3/1\n", False),
+])
+def test_vertex_lines_in_blocks_or_scattered(text, bulk):
+    fast = obj._read_bulk(text)
+    assert (fast is not None) == bulk
+    if fast is not None:
+        assert_same_mesh(fast, obj._read_general(text, "t.obj"))
+
+
+def test_a_short_vertex_line_is_not_made_up_from_the_next_one(tmp_path):
+    """``v 0 0`` then ``v 1 0 0 0`` hold six numbers for two vertices: counting numbers over
+    all lines (the bulk reader before) read them as (0, 0, 1) and (0, 0, 0)."""
+    path = tmp_path / "short.obj"
+    path.write_text("v 0 0\nv 1 0 0 0\nv 0 1 0\nf 1 2 3\n")
+    with pytest.raises(InputError, match="malformed 'v' line"):
+        read_mesh(str(path))
 
 
 def test_line_breaks_other_than_newline_go_line_by_line():
