@@ -25,7 +25,9 @@ def geometry_problem(V, F):
     F = solvable_faces(np.asarray(F))
     if not len(F):
         return "no triangle has three distinct vertices"
-    diag = float(np.linalg.norm(np.ptp(V[np.unique(F)], axis=0)))
+    used = np.zeros(len(V), dtype=bool)
+    used[F.ravel()] = True  # not np.unique: a sort of every corner (0.5 s at 2.5M faces)
+    diag = float(np.linalg.norm(np.ptp(V[used], axis=0)))
     if not 1e-100 < diag < 1e100:
         return (f"its vertices span {diag:.3g}: too small or too large to solve in double "
                 "precision; rescale the mesh")
