@@ -1,6 +1,6 @@
 """Fans around each vertex (non-manifold vertices) against a per-vertex union-find written out
 here and against libigl's ``is_vertex_manifold``; the one-way edge adjacency against the
-symmetric one."""
+symmetric one; the extent check over used vertices."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -8,7 +8,13 @@ from helpers import torus, tube_mesh
 
 from srarap_cli.solver.group_rotations import connected_groups
 from srarap_cli.solver.libigl import igl
-from srarap_cli.solver.mesh_checks import edge_adjacency, fans_per_vertex, mesh_warnings, solvable_faces
+from srarap_cli.solver.mesh_checks import (
+    edge_adjacency,
+    fans_per_vertex,
+    geometry_problem,
+    mesh_warnings,
+    solvable_faces,
+)
 
 
 def root(group, i):
@@ -99,3 +105,10 @@ def test_one_way_adjacency_groups_handles_as_the_symmetric_one(seed):
     ids = np.sort(np.random.default_rng(seed).choice(n, size=n // 3, replace=False))
     assert np.array_equal(connected_groups(edge_adjacency(F, n), ids),
                           connected_groups(both, ids))
+
+
+def test_geometry_span_counts_only_vertices_faces_use():
+    F = np.array([[0, 1, 2]])
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1e200, 0, 0]])  # the last one unused
+    assert geometry_problem(V, F) is None
+    assert "too small or too large" in geometry_problem(V * 1e-120, F)
