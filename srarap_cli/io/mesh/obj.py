@@ -87,8 +87,8 @@ def _block(text, head):
     """The numbers of every ``head`` line as one text, and how many lines: from one slice
     when those lines come together, as writers put them (a third of a findall's time)."""
     key = f"\n{head} "
-    at = 0 if text.startswith(head + " ") else text.find(key) + 1
-    if at == 0 and not text.startswith(head + " "):
+    at = 0 if text.startswith(head + " ") else text.find(key) + 1 or None
+    if at is None:
         return "", 0
     end = text.find("\n", text.rfind(key) + 1)
     block = text[at:len(text) if end < 0 else end]
@@ -119,8 +119,9 @@ def _statements(text, read):
 
 
 def _rows_of(numbers, lines, least):
-    """The first three numbers of each of ``lines`` lines (text, one line each) when every
-    line holds as many, ``least`` or more, as the general reader takes them; None otherwise.
+    """Rows of the first three numbers of ``lines`` lines of text (as the general reader
+    takes them) when every line holds the same count of numbers, at least ``least``; None
+    otherwise.
 
     numpy's C ``loadtxt`` checks the count line by line: a count over all lines let one
     line's extra number stand in for another's missing one (``v 0 0`` then ``v 1 0 0 0``
