@@ -65,7 +65,7 @@ def _ascii_rows(table, mesh):
 def _face_bytes(mesh):
     """Each polygon as a uint8 corner count followed by int32 vertex ids."""
     sizes = mesh.face_sizes
-    if sizes.size and (sizes == sizes[0]).all():  # one record type: no scatter (1.2 -> 0.1 s)
+    if sizes.size and (sizes == sizes[0]).all():  # one record type, no scatter: 1.4 -> 0.16 s
         k = int(sizes[0])
         table = np.empty(sizes.size, dtype=[("n", "u1"), ("ids", "<i4", (k,))])
         table["n"] = k
