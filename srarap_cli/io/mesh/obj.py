@@ -238,11 +238,9 @@ _CORNER_FORMS = {(False, False): "%d", (True, False): "%d/%d", (False, True): "%
 
 
 def _face_block(mesh, offsets, first, stop):
-    """The ``f`` lines of polygons ``first:stop`` at once when they have one size and their
-    corners one form (a fifth of the time of :func:`_face_lines`, or less); None otherwise."""
+    """The ``f`` lines of polygons ``first:stop``, all of one size, at once when their corners
+    have one form (a fifth of the time of :func:`_face_lines`, or less); None otherwise."""
     sizes = mesh.face_sizes[first:stop]
-    if (sizes != sizes[0]).any():
-        return None
     corners = slice(offsets[first], offsets[stop])
     columns, has = [mesh.face_vertices[corners]], []
     for ids in (mesh.face_uv, mesh.face_normals):
@@ -274,13 +272,14 @@ def format_obj(mesh):
     lines = _face_lines(mesh, offsets, 0, count) if 8 * len(bounds) > count else None
     for first, stop in zip(bounds, bounds[1:]):
         parts.extend(later.get(first, ()))
-        parts.extend(lines[first:stop] if lines is not None
-                     else _face_text(mesh, offsets, first, stop))
+        if stop > first:
+            parts.extend(lines[first:stop] if lines is not None
+                         else _face_text(mesh, offsets, first, stop))
     return "".join(parts)
 
 
 def _face_text(mesh, offsets, first, stop):
-    """The ``f`` lines of polygons ``first:stop``: in blocks of one polygon size (a quad
+    """The ``f`` lines of polygons ``first:stop`` (at least one): in blocks of one polygon size (a quad
     mesh's triangle caps, say), or line by line when the sizes alternate too often for
     blocks to pay or the corners' forms differ."""
     changes = first + 1 + np.flatnonzero(np.diff(mesh.face_sizes[first:stop]))
@@ -289,6 +288,6 @@ def _face_text(mesh, offsets, first, stop):
     bounds = [first, *changes.tolist(), stop]
     out = []
     for a, b in zip(bounds, bounds[1:]):
-        block = _face_block(mesh, offsets, a, b) if b > a else ""
+        block = _face_block(mesh, offsets, a, b)
         out.extend([block] if block is not None else _face_lines(mesh, offsets, a, b))
     return out
