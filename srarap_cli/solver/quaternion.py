@@ -110,6 +110,25 @@ def from_axis_angle(axis, degrees):
     return np.concatenate([[np.cos(half)], np.sin(half) * axis / np.linalg.norm(axis)])
 
 
+def from_rotation_vectors(w):
+    """Unit quaternions (n, 4) of rotations by the vectors ``w`` (n, 3): angle ``|w|``
+    (radians) about ``w``'s direction, ``exp(w / 2)``.
+
+    Examples
+    --------
+    >>> q = from_rotation_vectors(np.array([[0, 0, np.pi / 2]]))
+    >>> np.round(rotate(q, np.array([1., 0, 0])), 12)
+    array([[0., 1., 0.]])
+    """
+    w = np.asarray(w, dtype=float)
+    angle = np.linalg.norm(w, axis=1)
+    half = 0.5 * angle
+    # sin(h) / (2 h) -> 1/2 at 0; the series is exact to rounding below 1e-4 radians
+    scale = np.where(angle > 1e-4, np.sin(half) / np.where(angle > 0, angle, 1.0),
+                     0.5 - angle * angle / 48.0)
+    return np.column_stack([np.cos(half), scale[:, None] * w])
+
+
 def normalize(q, fallback):
     """Scale quaternions to unit length; rows too short to normalize take ``fallback``.
 

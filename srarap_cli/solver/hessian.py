@@ -1,0 +1,133 @@
+"""Second derivatives of the SR-ARAP energy at one state, as matrix-free products.
+
+The variables are the positions' increments ``u`` (n, 3) and the rotors' increments ``w``
+(n, 3), a rotor moving as ``R -> exp(w / 2) R`` (its rotation turned by the vector ``w``
+after ``R``). Half the Hessian, ``Q = H / 2``, has three blocks:
+
+- ``Q_uu = 2 K`` per coordinate, ``K`` the cotangent Laplacian (the membrane is quadratic in
+  the positions), so its inverse is one Poisson solve;
+- ``Q_wu``: a directed edge ``i -> j`` with rotated rest edge ``a = R_i q_ij R_i~`` couples
+  ``w_i`` with ``u_i - u_j`` through ``c_ij [a]x``;
+- ``Q_ww``: per cell a 3x3 block of the membrane, ``sum_j c_ij ((|a|^2 - r.a) I - a a^T +
+  (r a^T + a r^T) / 2)`` with the residual ``r = a - p_ij``, and the bending term's graph
+  coupling: an edge with weight ``beta`` and relative rotor ``D = R_j R_i~`` (hemisphere
+  aligned) adds ``beta (D)_w / 4`` to both diagonals and ``-beta vec(v D) / 4`` to row ``i``
+  for ``v = w_j`` (its transpose, ``-beta vec(v D~) / 4``, to row ``j`` for ``v = w_i``).
+
+These follow from expanding ``exp(w) a = a + w x a + w x (w x a) / 2`` in the membrane and
+``|R_i' - R_j'|^2 = 2 - 2 R_i'.R_j'`` with ``exp(w / 2) = (1 - |w|^2 / 8, w / 2)`` in the
+bending term to second order; tests/test_hessian.py checks them against finite differences of
+:func:`~srarap_cli.solver.energy.membrane_energy` and
+:func:`~srarap_cli.solver.energy.bending_energy`.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .quaternion import multiply, rotate, to_matrix
+
+_CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
+
+
+@dataclass
+class EnergyHessian:
+    """Products with the blocks ``Q_ww`` and ``Q_wu`` of half the energy's Hessian at one
+    state (see the module's text), and with ``Q_wu``'s transpose.
+
+    Per-edge values are kept as (3, m) rows: the products gather, cross and sum contiguous
+    rows (three times faster than on (m, 3) arrays at 69k edges).
+
+    Attributes
+    ----------
+    n : int, vertices
+    """
+
+    n: int
+    _I: np.ndarray
+    _J: np.ndarray
+    _ca: np.ndarray        # (3, m) c_ij a_ij
+    _ca_sums: np.ndarray   # (n, 3) sum_j c_ij a_ij
+    _cells: np.ndarray     # (n, 3, 3) membrane blocks plus the bending diagonal
+    _beta_w: np.ndarray    # (m,) bending weight / 4 times D's scalar part
+    _beta_v: np.ndarray    # (3, m) bending weight / 4 times D's vector part
+
+    def rotations(self, v: np.ndarray) -> np.ndarray:
+        """``Q_ww v`` for rotor increments ``v`` (n, 3): (n, 3)."""
+        out = np.einsum("nab,nb->na", self._cells, v)
+        rows = np.ascontiguousarray(v.T)
+        # vec(v D) = d_w v + v x d for a pure quaternion v, vec(v D~) = d_w v - v x d
+        vj = np.take(rows, self._J, axis=1)
+        out -= self._sum(self._beta_w * vj + _cross(vj, self._beta_v), self._I)
+        vi = np.take(rows, self._I, axis=1)
+        out -= self._sum(self._beta_w * vi - _cross(vi, self._beta_v), self._J)
+        return out
+
+    def coupling(self, u: np.ndarray) -> np.ndarray:
+        """``Q_wu u`` for position increments ``u`` (n, 3): (n, 3) on the rotors."""
+        uj = np.take(np.ascontiguousarray(u.T), self._J, axis=1)
+        return np.cross(self._ca_sums, u) - self._sum(_cross(self._ca, uj), self._I)
+
+    def coupling_t(self, v: np.ndarray) -> np.ndarray:
+        """``Q_uw v`` for rotor increments ``v`` (n, 3): (n, 3) on the positions."""
+        vi = np.take(np.ascontiguousarray(v.T), self._I, axis=1)
+        return self._sum(_cross(self._ca, vi), self._J) - np.cross(self._ca_sums, v)
+
+    def _sum(self, rows, labels):
+        """Per-vertex sums (n, 3) of per-edge rows (3, m) by ``labels``."""
+        return np.column_stack([np.bincount(labels, r, self.n) for r in rows])
+
+
+def energy_hessian(graph, edges, P, R, bending_weight):
+    """Half the Hessian of the SR-ARAP energy at positions ``P`` and rotors ``R``.
+
+    The membrane blocks are per-cell sums, formed from per-cell moments instead of per
+    edge: with ``A_i = sum_j c a a^T = R_i T_i R_i^T`` (``T_i`` the rest moment
+    ``sum_j c q q^T``) and ``C_i = sum_j c r a^T = A_i - S_i R_i^T`` (``S_i`` the covariance
+    of :meth:`RestEdges.cross`), a block is ``(s_i - tr C_i) I - A_i + (C_i + C_i^T) / 2``.
+
+    Parameters
+    ----------
+    graph : CellGraph
+    edges : RestEdges of the graph
+    P : (n, 3) float array
+    R : (n, 4) float array, unit quaternions
+    bending_weight : float, ``alpha * A`` (0: classic ARAP)
+
+    Returns
+    -------
+    EnergyHessian
+
+    Examples
+    --------
+    >>> from srarap_cli.solver.operators import cell_graph
+    >>> from srarap_cli.solver.rest_edges import RestEdges
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> g = cell_graph(V, np.array([[0, 1, 2]]), "uniform")
+    >>> H = energy_hessian(g, RestEdges(g, V), V, np.tile([1., 0, 0, 0], (3, 1)), 1.0)
+    >>> u = np.tile([0.3, -0.1, 0.2], (3, 1))   # a translation costs nothing
+    >>> bool(np.abs(H.coupling(u)).max() < 1e-15)
+    True
+    """
+    I, J, c = graph.I, graph.J, graph.c
+    n = graph.n
+    Rm = to_matrix(R)
+    A = Rm @ edges.rest_moment @ Rm.transpose(0, 2, 1)
+    C = A - edges.cross(P) @ Rm.transpose(0, 2, 1)
+    trace = np.einsum("nii->n", C)
+    cells = (edges.rest_scale - trace)[:, None, None] * np.eye(3) - A + 0.5 * (
+        C + C.transpose(0, 2, 1))
+    Ri, Rj = np.take(R, I, axis=0), np.take(R, J, axis=0)
+    sign = np.where(np.einsum("ij,ij->i", Ri, Rj) < 0, -1.0, 1.0)
+    relative = multiply(Rj * sign[:, None], Ri * _CONJUGATE)
+    beta = bending_weight / 4.0 / np.take(graph.degree, I)
+    beta_w = beta * relative[:, 0]
+    cells += (np.bincount(I, beta_w, n) + np.bincount(J, beta_w, n))[:, None, None] * np.eye(3)
+    return EnergyHessian(n, I, J, np.ascontiguousarray((c[:, None] * rotate(Ri, edges.q)).T),
+                         np.einsum("nab,nb->na", Rm, edges.sum_cq), cells, beta_w,
+                         np.ascontiguousarray((beta[:, None] * relative[:, 1:]).T))
+
+
+def _cross(a, b):
+    """``a x b`` of vectors stored as (3, m) rows."""
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])

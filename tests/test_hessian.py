@@ -1,0 +1,87 @@
+"""energy_hessian: half the SR-ARAP energy's Hessian, against finite differences of the energy
+and the invariances it must have."""
+import numpy as np
+import pytest
+from helpers import ends, tube
+
+from srarap_cli import Deformer
+from srarap_cli.solver.hessian import energy_hessian
+from srarap_cli.solver.quaternion import IDENTITY, from_rotation_vectors, multiply
+
+
+@pytest.fixture(scope="module")
+def state():
+    """A bent tube's solve, then every position and rotor perturbed (so the residual terms of
+    the Hessian, which vanish on an exact fit, are exercised)."""
+    V, F = tube(rings=8, segments=6)
+    ids = ends(V)
+    d = Deformer(V, F, ids)
+    T = V[ids].copy()
+    T[T[:, 2] > 1] += [1.0, 0.0, -0.5]
+    r = d.solve(T, tol=1e-10, max_iter=500)
+    rng = np.random.default_rng(3)
+    P = r.positions + 0.05 * rng.standard_normal(V.shape)
+    R = multiply(from_rotation_vectors(0.2 * rng.standard_normal((len(V), 3))), r.rotors)
+    return d, P, R, rng
+
+
+def quadratic(d, H, u, w):
+    """``x^T H x`` for x = (u, w) from the blocks (H = 2 Q; Q_uu = 2 K per coordinate)."""
+    Ku = d.graph.laplacian @ u
+    return 2.0 * (2.0 * np.sum(u * Ku) + 2.0 * np.sum(w * H.coupling(u))
+                  + np.sum(w * H.rotations(w)))
+
+
+@pytest.mark.parametrize("part", ["positions", "rotors", "both"])
+def test_second_derivatives_match_finite_differences_of_the_energy(state, part):
+    d, P, R, rng = state
+    H = energy_hessian(d.graph, d.edges, P, R, d.bending_weight)
+    n = len(P)
+    for _ in range(3):
+        u = rng.standard_normal((n, 3)) * (part != "rotors")
+        w = rng.standard_normal((n, 3)) * (part != "positions")
+
+        def energy(t, u=u, w=w):
+            return d.energy(P + t * u, multiply(from_rotation_vectors(t * w), R))["total"]
+
+        h = 1e-4
+        second = (energy(h) - 2 * energy(0.0) + energy(-h)) / h ** 2
+        assert quadratic(d, H, u, w) == pytest.approx(second, rel=1e-5)
+
+
+def test_the_bending_part_matches_finite_differences_of_the_bending_energy(state):
+    """A bending weight of 0 (classic ARAP) leaves the membrane alone: the difference is the
+    bending term's curvature."""
+    d, P, R, rng = state
+    membrane = energy_hessian(d.graph, d.edges, P, R, 0.0)
+    full = energy_hessian(d.graph, d.edges, P, R, d.bending_weight)
+    w = rng.standard_normal((len(P), 3))
+    bending = full.rotations(w) - membrane.rotations(w)
+    h = 1e-4
+    values = [d.bending(multiply(from_rotation_vectors(t * w), R)) for t in (-h, 0.0, h)]
+    second = (values[0] - 2 * values[1] + values[2]) / h ** 2
+    assert 2.0 * np.sum(w * bending) == pytest.approx(second, rel=1e-5)
+
+
+def test_products_are_symmetric(state):
+    d, P, R, rng = state
+    H = energy_hessian(d.graph, d.edges, P, R, d.bending_weight)
+    a, b = rng.standard_normal((2, len(P), 3))
+    assert np.sum(a * H.rotations(b)) == pytest.approx(np.sum(b * H.rotations(a)), rel=1e-12)
+    assert np.sum(a * H.coupling(b)) == pytest.approx(np.sum(b * H.coupling_t(a)), rel=1e-12)
+
+
+def test_rigid_motions_of_the_rest_shape_cost_nothing(state):
+    """At rest (E = 0, a minimum), turning and moving everything together is a null
+    direction: u = omega x V + t, w = omega."""
+    d, _, _, rng = state
+    V = d.V
+    H = energy_hessian(d.graph, d.edges, V, np.tile(IDENTITY, (len(V), 1)), d.bending_weight)
+    omega, shift = rng.standard_normal(3), rng.standard_normal(3)
+    u = np.cross(omega, V) + shift
+    w = np.tile(omega, (len(V), 1))
+    scale = np.abs(H.rotations(w)).max()
+    on_rotors = H.rotations(w) + H.coupling(u)
+    on_positions = H.coupling_t(w) + 2.0 * (d.graph.laplacian @ u)
+    assert np.abs(on_rotors).max() < 1e-12 * scale
+    assert np.abs(on_positions).max() < 1e-12 * scale
