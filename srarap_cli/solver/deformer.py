@@ -20,11 +20,12 @@ from .drivers import DRIVERS, Monitor
 from .energy import bending_energy, membrane_energy
 from .global_step import PoissonSolver
 from .group_rotations import connected_groups
+from .linear_response import LinearResponse
 from .local_step import METHODS
 from .operators import cell_graph
 from .rest_edges import RestEdges
 from .settings import DEFAULTS, HANDLE_ROTORS
-from .starts import STARTS
+from .starts import STARTS, WARM_STARTS
 from .step import LocalGlobalStep
 
 # the ``accel`` setting names a driver
@@ -203,6 +204,7 @@ class Deformer:
         self._bending_alpha = self.alpha if METHODS[method].bending else 0.0
         self._poisson: PoissonSolver | None = None
         self._local_step: Any = None
+        self._response: LinearResponse | None = None
         if prepare:
             self.prepare()
 
@@ -230,6 +232,19 @@ class Deformer:
     def poisson(self) -> Any:
         """The factored Poisson matrix (global step)."""
         return self.prepare()._poisson
+
+    @property
+    def linear_response(self) -> LinearResponse:
+        """The first-order change of a solved state under a move of the held vertices
+        (warm starts); built on first use."""
+        if self._response is None:
+            self._response = LinearResponse(self.prepare())
+        return self._response
+
+    @property
+    def bending_weight(self) -> float:
+        """``alpha * A``, the bending term's factor (0 for classic ARAP)."""
+        return self._bending_alpha * self.area
 
     @property
     def local_step(self) -> Any:
@@ -285,9 +300,12 @@ class Deformer:
             :mod:`srarap_cli.solver.drivers.monitor`)
         time_limit : float, optional; stop (not converged) once this many seconds have passed
         accel : {"anderson", "none"}, the driver: accelerated or plain iteration
-        start : str, a name in :data:`srarap_cli.solver.starts.STARTS` (``harmonic``,
-            ``laplacian``); ignored when ``initial`` is given (warm start)
-        initial : (positions (n, 3), rotors (n, 4)), optional warm start
+        start : str, a name in :data:`srarap_cli.solver.starts.STARTS`: ``harmonic`` or
+            ``laplacian`` without ``initial``; with it, ``warm`` (any other name) or
+            ``extrapolated`` (see :mod:`srarap_cli.solver.starts.warm`)
+        initial : (positions (n, 3), rotors (n, 4)), optional warm start: an earlier
+            solve's result (``warm``: the start follows the change of the targets to first
+            order) or a state that already follows them (``extrapolated``)
         callback : callable(dict), called with each log row
         driver : str or callable, optional, a name in :data:`srarap_cli.solver.drivers.DRIVERS`
             or a driver itself; overrides ``accel``
@@ -305,7 +323,9 @@ class Deformer:
                           callback=callback, energy_scale=self.energy_scale,
                           scale=float(np.linalg.norm(extent)))
         step = self.step_for(targets, tol)
-        first = STARTS["warm" if initial is not None else start](step, initial)
+        if initial is not None and start not in WARM_STARTS:
+            start = "warm"
+        first = STARTS[start](step, initial)
         if not callable(driver):
             driver = DRIVERS[driver or ACCEL_DRIVERS[accel]]
         state = driver(step, first, monitor)

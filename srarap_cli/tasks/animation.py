@@ -101,9 +101,11 @@ class Animator:
             start = time.perf_counter()
             frame_targets = self.constraints.targets_at(float(f))
             targets = self.problem.targets_for(frame_targets)
-            result = self.deformer.solve(targets, max_iter=max_iter, tol=tol,
-                                         **self.solve_options,
-                                         initial=None if P is None else _carried(P, R, before))
+            options = dict(self.solve_options)
+            if P is not None:
+                # the carried frames follow the targets to first order already
+                options.update(start="extrapolated", initial=_carried(P, R, before))
+            result = self.deformer.solve(targets, max_iter=max_iter, tol=tol, **options)
             self.last_result = result
             # the solver's own rotors against the previous frame's: negative means a sign flip
             dot = 1.0 if R is None else float(np.einsum("ij,ij->i", result.rotors, R).min())

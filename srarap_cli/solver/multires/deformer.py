@@ -19,7 +19,7 @@ from ..group_rotations import connected_groups, group_rotors
 from ..mesh_checks import edge_adjacency
 from ..quaternion import IDENTITY
 from ..settings import DEFAULTS
-from ..starts import STARTS
+from ..starts import STARTS, WARM_STARTS
 from .cache import coarse_mesh
 from .correction import CoarseCorrection
 from .dirichlet import DirichletSolver
@@ -260,7 +260,7 @@ class MultiresDeformer:
         targets = api_checks.targets(targets, len(self.constrained))
         if initial is not None and self.mode == "refine":
             return self._warm(targets, initial, callback, tol, accel, begin,
-                              max_iter=max_iter, time_limit=time_limit)
+                              max_iter=max_iter, time_limit=time_limit, start=start)
         cv = self.coarse.vertices
         warm = None if initial is None else (np.asarray(initial[0])[cv],
                                               np.asarray(initial[1])[cv])
@@ -346,11 +346,12 @@ class MultiresDeformer:
         step = self.fine.step_for(targets, tol)
         prolonged = prolong(self.V, self._nearest, self.coarse.vertices, coarse.positions,
                             coarse.rotors)
-        candidates = [step(STARTS["warm"](step, prolonged))]
+        candidates = [step(STARTS["extrapolated"](step, prolonged))]
         if initial is None:
             candidates.append(STARTS[start](step, None))
         else:
-            candidates.append(step(STARTS["warm"](step, initial)))
+            candidates.append(step(STARTS[start if start in WARM_STARTS else "warm"](
+                step, initial)))
         best = min(candidates, key=lambda state: state.total)
         return best.positions, best.rotors
 

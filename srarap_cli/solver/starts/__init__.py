@@ -6,9 +6,12 @@ or None. :data:`STARTS` maps names to starts; :func:`register` adds one.
 """
 from .harmonic import harmonic_start
 from .laplacian import laplacian_start
-from .warm import warm_start
+from .warm import extrapolated_start, warm_start
 
-STARTS = {"harmonic": harmonic_start, "laplacian": laplacian_start, "warm": warm_start}
+STARTS = {"harmonic": harmonic_start, "laplacian": laplacian_start, "warm": warm_start,
+          "extrapolated": extrapolated_start}
+#: the starts that take the caller's ``initial``; ``warm`` is the default one
+WARM_STARTS = ("warm", "extrapolated")
 
 
 def register(name, start):
