@@ -24,9 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .quaternion import multiply, rotate, to_matrix
-
-_CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
+from .quaternion import to_matrix
 
 
 @dataclass
@@ -116,15 +114,23 @@ def energy_hessian(graph, edges, P, R, bending_weight):
     trace = np.einsum("nii->n", C)
     cells = (edges.rest_scale - trace)[:, None, None] * np.eye(3) - A + 0.5 * (
         C + C.transpose(0, 2, 1))
-    Ri, Rj = np.take(R, I, axis=0), np.take(R, J, axis=0)
-    sign = np.where(np.einsum("ij,ij->i", Ri, Rj) < 0, -1.0, 1.0)
-    relative = multiply(Rj * sign[:, None], Ri * _CONJUGATE)
+    # per-edge work on (k, m) rows: contiguous gathers and products
+    rows = np.ascontiguousarray(R.T)
+    Ri, Rj = np.take(rows, I, axis=1), np.take(rows, J, axis=1)
+    dots = np.einsum("km,km->m", Ri, Rj)
     beta = bending_weight / 4.0 / np.take(graph.degree, I)
-    beta_w = beta * relative[:, 0]
+    # D = s R_j R_i~ with s the sign that aligns the pair: scalar |R_i.R_j|, vector
+    # s (w_i v_j - w_j v_i + v_i x v_j)
+    beta_w = beta * np.abs(dots)
+    beta_v = (beta * np.where(dots < 0, -1.0, 1.0)) * (
+        Ri[0] * Rj[1:] - Rj[0] * Ri[1:] + _cross(Ri[1:], Rj[1:]))
     cells += (np.bincount(I, beta_w, n) + np.bincount(J, beta_w, n))[:, None, None] * np.eye(3)
-    return EnergyHessian(n, I, J, np.ascontiguousarray((c[:, None] * rotate(Ri, edges.q)).T),
-                         np.einsum("nab,nb->na", Rm, edges.sum_cq), cells, beta_w,
-                         np.ascontiguousarray((beta[:, None] * relative[:, 1:]).T))
+    # a = R_i q R_i~: t = 2 v x q, a = q + w t + v x t
+    q = np.ascontiguousarray(edges.q.T)
+    t = 2.0 * _cross(Ri[1:], q)
+    a = q + Ri[0] * t + _cross(Ri[1:], t)
+    return EnergyHessian(n, I, J, c * a, np.einsum("nab,nb->na", Rm, edges.sum_cq), cells,
+                         beta_w, beta_v)
 
 
 def _cross(a, b):

@@ -19,7 +19,7 @@ from ..group_rotations import connected_groups, group_rotors
 from ..mesh_checks import edge_adjacency
 from ..quaternion import IDENTITY
 from ..settings import DEFAULTS
-from ..starts import STARTS, WARM_STARTS
+from ..starts import STARTS
 from .cache import coarse_mesh
 from .correction import CoarseCorrection
 from .dirichlet import DirichletSolver
@@ -273,10 +273,10 @@ class MultiresDeformer:
         if self.mode == "transfer":
             return self._transfer(targets, coarse, log, stages, begin)
         mark = time.perf_counter()
-        first = self._fine_start(targets, tol, coarse, start, initial)
+        first = self._fine_start(targets, tol, coarse, start)
         stages["fine_start"] = time.perf_counter() - mark
         mark = time.perf_counter()
-        fine = self.fine.solve(targets, initial=first, callback=callback,
+        fine = self.fine.solve(targets, initial=first, start="extrapolated", callback=callback,
                                driver=self._driver(targets, tol, accel),
                                **solve_options)
         stages["fine_iterations"] = time.perf_counter() - mark
@@ -331,10 +331,10 @@ class MultiresDeformer:
             return None
         return partial(anderson_iteration, correction=self.coarse_correction(targets, tol))
 
-    def _fine_start(self, targets, tol, coarse, start, initial):
+    def _fine_start(self, targets, tol, coarse, start):
         """The lower-energy of two full-resolution starts: one local/global step from the
         coarse result moved rigidly with each vertex's nearest coarse vertex, and the
-        solver's own start (``start``, or the caller's ``initial`` after one step). The
+        solver's own start (``start``; a caller's ``initial`` goes to :meth:`_warm`). The
         coarse solution is the better start where the deformation needs rotations the
         handles do not give (the Max bust's translated handles: 2% above the minimum against
         21%); the harmonic start where the handles give them all (exact for a rigid motion),
@@ -346,12 +346,7 @@ class MultiresDeformer:
         step = self.fine.step_for(targets, tol)
         prolonged = prolong(self.V, self._nearest, self.coarse.vertices, coarse.positions,
                             coarse.rotors)
-        candidates = [step(STARTS["extrapolated"](step, prolonged))]
-        if initial is None:
-            candidates.append(STARTS[start](step, None))
-        else:
-            candidates.append(step(STARTS[start if start in WARM_STARTS else "warm"](
-                step, initial)))
+        candidates = [step(STARTS["extrapolated"](step, prolonged)), STARTS[start](step, None)]
         best = min(candidates, key=lambda state: state.total)
         return best.positions, best.rotors
 
