@@ -157,3 +157,24 @@ def test_sample_mesh_takes_the_bulk_path_and_round_trips():
     assert fast is not None and fast.normals is not None
     assert_same_mesh(fast, obj._read_general(text, path))
     assert_same_mesh(obj._read_bulk(obj.format_obj(fast)), fast)
+
+
+@pytest.mark.parametrize("kind", ["normals and statements", "uvs", "plain"])
+def test_animation_frames_are_the_files_format_obj_writes(kind):
+    """``obj_frames`` formats faces, statements and uvs once: each frame must still be the
+    corner-by-corner reference of the moved mesh (normals recomputed for each frame)."""
+    spot = read_mesh(os.path.join(ROOT, "sample_meshes", "spot.obj"))
+    if kind == "normals and statements":
+        spot.statements = [(0, "o cow"), (100, "usemtl a"), (spot.face_sizes.size, "g end")]
+    elif kind == "uvs":
+        spot = obj._read_bulk(SQUARE + "f 1/1 2/2 4/1 3/3\nf 1/1 2/2 3/3\n")
+    else:
+        spot.normals = spot.face_normals = None
+    frame = obj.obj_frames(spot)
+    rng = np.random.default_rng(1)
+    for _ in range(2):
+        moved = spot.vertices + rng.normal(scale=0.1, size=spot.vertices.shape)
+        expected = spot.with_vertices(moved)
+        assert frame(moved) == reference_obj(expected).encode("utf-8")
+        assert kind != "normals and statements" or not np.allclose(expected.normals,
+                                                                    spot.normals)

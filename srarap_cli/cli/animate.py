@@ -9,7 +9,7 @@ import time
 import click
 
 from ..io.handles import load_handles, referenced_files
-from ..io.mesh import WRITE_FORMATS, format_mesh, read_mesh
+from ..io.mesh import WRITE_FORMATS, frame_formatter, read_mesh
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
@@ -84,9 +84,10 @@ def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, ke
     animator = Animator(source, constraints, opts, cache=cache, name=mesh)
     progress = _Progress(n_frames, enabled=verbosity != 0 and sys.stderr.isatty())
 
+    frame_bytes = frame_formatter(source, _suffix(pattern))
+
     def write_frame(f, positions, st):
-        data, _ = format_mesh(source.with_vertices(positions), _suffix(pattern))
-        commit_files([(pattern.format(f), data), (state_path, st.to_bytes())])
+        commit_files([(pattern.format(f), frame_bytes(positions)), (state_path, st.to_bytes())])
         progress.update(f + 1)
 
     budget = iters_per_frame is not None

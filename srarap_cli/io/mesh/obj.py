@@ -256,26 +256,55 @@ def _face_block(mesh, offsets, first, stop):
 
 def format_obj(mesh):
     """OBJ text for ``mesh``: deterministic, coordinates with 17 significant digits."""
+    head, faces = _fixed_text(mesh)
+    return head + _vertex_lines(mesh) + _uv_lines(mesh) + _normal_lines(mesh) + faces
+
+
+def obj_frames(mesh):
+    """``frame(positions) -> bytes``: the OBJ file of ``mesh`` with other positions (normals
+    recomputed for them), as :func:`format_obj` writes it. What the positions do not change
+    (statements, texture coordinates, faces) is formatted once."""
+    head, faces = _fixed_text(mesh)
+    uv = _uv_lines(mesh)
+
+    def frame(positions):
+        moved = mesh.with_vertices(positions)
+        return (head + _vertex_lines(moved) + uv + _normal_lines(moved) + faces).encode("utf-8")
+
+    return frame
+
+
+def _vertex_lines(mesh):
+    return _rows("v %.17g %.17g %.17g\n", mesh.vertices)
+
+
+def _uv_lines(mesh):
+    return "" if mesh.uv is None else _rows("vt" + " %.17g" * mesh.uv.shape[1] + "\n", mesh.uv)
+
+
+def _normal_lines(mesh):
+    return "" if mesh.normals is None else _rows("vn %.17g %.17g %.17g\n", mesh.normals)
+
+
+def _fixed_text(mesh):
+    """The text before the coordinates (the header, statements before any face) and after
+    them (faces, with the statements among them)."""
     later, count = {}, mesh.face_sizes.size
     for k, s in mesh.statements:  # one said to follow more faces than there are goes last
         later.setdefault(min(k, count), []).append(s + "\n")
-    parts = ["# written by srarap\n", *later.pop(0, ())]
-    parts.append(_rows("v %.17g %.17g %.17g\n", mesh.vertices))
-    if mesh.uv is not None:
-        parts.append(_rows("vt" + " %.17g" * mesh.uv.shape[1] + "\n", mesh.uv))
-    if mesh.normals is not None:
-        parts.append(_rows("vn %.17g %.17g %.17g\n", mesh.normals))
+    head = "".join(["# written by srarap\n", *later.pop(0, ())])
     # faces in runs between the statements among them (usemtl, g, s, ...); when those come
     # every few faces, blocks would cost more than one pass line by line
     offsets = mesh.face_offsets
     bounds = [0, *sorted(later), count]
     lines = _face_lines(mesh, offsets, 0, count) if 8 * len(bounds) > count else None
+    parts = []
     for first, stop in zip(bounds, bounds[1:]):
         parts.extend(later.get(first, ()))
         if stop > first:
             parts.extend(lines[first:stop] if lines is not None
                          else _face_text(mesh, offsets, first, stop))
-    return "".join(parts)
+    return head, "".join(parts)
 
 
 def _face_text(mesh, offsets, first, stop):
