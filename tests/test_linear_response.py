@@ -105,3 +105,15 @@ def test_rotation_vectors_match_axis_angle():
         axis /= np.linalg.norm(axis)
         q = from_rotation_vectors((angle * axis)[None])[0]
         assert np.allclose(q, from_axis_angle(axis, np.degrees(angle)), rtol=0, atol=1e-15)
+
+
+def test_the_papers_system_keeps_the_rotations_only(solved):
+    """sr-linear's fixed point is not the energy's minimum: no response is added."""
+    d0, T, _ = solved
+    d = Deformer(d0.V, d0.F, d0.constrained, method="sr-linear")
+    first = d.solve(T, tol=1e-10, max_iter=3000)
+    step = d.step_for(T * 1.01)
+    warm = STARTS["warm"](step, (first.positions, first.rotors))
+    plain = STARTS["extrapolated"](step, (first.positions, first.rotors))
+    assert np.array_equal(warm.positions, plain.positions)
+    assert d.local_step.near_minimum is False and d0.local_step.near_minimum is True

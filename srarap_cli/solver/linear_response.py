@@ -57,9 +57,9 @@ class LinearResponse:
                                     approximate=True)
 
     def rotations(self, P, R, moved):
-        """Rotor increments (n, 3) (rotation vectors, applied before ``R``) that follow the
-        held vertices' move ``moved`` to first order from the state ``(P, R)``; None when
-        the system gave no finite answer.
+        """Rotor increments ``w`` (n, 3), rotation vectors turning each rotor to
+        ``exp(w / 2) R``, that follow the held vertices' move ``moved`` to first order from
+        the state ``(P, R)``; None when the system gave no finite answer.
 
         Parameters
         ----------

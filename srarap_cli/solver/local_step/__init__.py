@@ -24,10 +24,14 @@ class LocalStep(Protocol):
     ----------
     bending : bool, the method's energy has the bending term (classic ARAP's has not)
     needs_stretch : bool, ``step`` uses the per-cell ``s`` (otherwise it gets None)
+    near_minimum : bool, the local/global iteration's fixed point is the energy's minimum or
+        close to it, so the energy's derivatives say how it moves (warm starts add their
+        first-order response to a move of the handles only then)
     """
 
     bending: ClassVar[bool]
     needs_stretch: ClassVar[bool]
+    near_minimum: ClassVar[bool]
 
     def __init__(self, edges: Any, constrained: np.ndarray, alpha_area: float,
                  feedback: float, **options: Any) -> None: ...

@@ -14,6 +14,7 @@ class ArapRotorStep:
 
     bending = False
     needs_stretch = False  # the rotation fit needs only S; the energy, only sum_i s_i
+    near_minimum = True
 
     def __init__(self, edges, constrained, alpha_area, feedback):
         """Nothing to precompute: each step fits rotations to the covariances alone."""

@@ -24,6 +24,7 @@ class SymmetricRotorStep(RotorSystem):
 
     bending = True
     needs_stretch = True
+    near_minimum = True
 
     def __init__(self, edges, constrained, alpha_area, feedback):
         graph = edges.graph

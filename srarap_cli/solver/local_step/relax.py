@@ -97,6 +97,7 @@ class RelaxRotorStep:
 
     bending = True
     needs_stretch = True
+    near_minimum = True
 
     def __init__(self, edges, constrained, alpha_area, feedback, sweeps=2):
         graph = edges.graph

@@ -16,7 +16,10 @@ start. Two candidates are made and the one of lower energy kept:
   5 / 9 / 9 / 19 iterations; from the second, 3 each (the stopping test's window).
 
 The positions of each follow from one global step. When the targets did not change, the
-start is the previous state after one more global step.
+start is the previous state after one more global step. The response is that of the energy's
+minimum: for the paper's own system (``sr-linear``), whose fixed point sits 1.3% to 5% above
+it, the lower-energy start was the farther one (Spot scaled by 1.01: 27 iterations, against
+26 with the rotations only), so that method keeps the first candidate alone.
 """
 import numpy as np
 
@@ -36,7 +39,7 @@ def warm_start(step, initial):
     d = step.deformer
     best = extrapolated_start(step, (P, R))
     moved = step.fixed_targets - P[d.fixed]
-    if not moved.any():
+    if not (moved.any() and d.local_step.near_minimum):
         return best
     w = d.linear_response.rotations(P, R, moved)
     if w is None:
