@@ -234,6 +234,24 @@ def test_bad_parameters_are_rejected(bar):
         Deformer(V, F, ids, weights="mean-value")
 
 
+@pytest.mark.parametrize("initial, message", [
+    ("P", r"initial must be a pair \(positions, rotors\)"),
+    (("P3", "R"), r"initial positions must be a \(\d+, 3\) array.*got shape \(3, 3\)"),
+    (("P", "R3"), r"initial rotors must be a \(\d+, 4\) array.*got shape \(\d+, 3\)"),
+    (("Pnan", "R"), "initial positions has NaN"),
+    (("P", "text"), "initial rotors must be an array of numbers"),
+])
+def test_a_malformed_warm_start_is_named(bar, initial, message):
+    V, F, ids = bar
+    d = Deformer(V, F, ids)
+    R = np.tile(IDENTITY, (len(V), 1))
+    values = {"P": V, "P3": V[:3], "Pnan": np.where(V > 0.5, np.nan, V), "R": R,
+              "R3": R[:, :3], "text": "rotors"}
+    state = values[initial] if isinstance(initial, str) else tuple(values[k] for k in initial)
+    with pytest.raises(ValueError, match=message):
+        d.solve(V[ids], initial=state)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("weights", ["cotan", "uniform"])
 def test_other_weight_kinds_reach_rigid_motion(bar, weights):

@@ -58,6 +58,26 @@ def targets(values: ArrayLike, k: int) -> np.ndarray:
     return values
 
 
+def initial(state: Any, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """A warm start ``(positions, rotors)`` as (n, 3) and (n, 4) finite float arrays (an
+    earlier result of the same mesh)."""
+    try:
+        positions, rotors = state
+    except (TypeError, ValueError):
+        raise ValueError("initial must be a pair (positions, rotors), such as an earlier "
+                         "result's (result.positions, result.rotors)") from None
+    out = []
+    for values, name, width in ((positions, "positions", 3), (rotors, "rotors", 4)):
+        values = _floats(values, f"initial {name}")
+        if values.shape != (n, width):
+            raise ValueError(f"initial {name} must be a ({n}, {width}) array, one row per "
+                             f"vertex, got shape {values.shape}")
+        if not np.isfinite(values).all():
+            raise ValueError(f"initial {name} has NaN or infinite values")
+        out.append(values)
+    return out[0], out[1]
+
+
 def _floats(values, name):
     try:
         return np.asarray(values, dtype=float)

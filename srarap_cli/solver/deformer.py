@@ -315,6 +315,8 @@ class Deformer:
         DeformResult
         """
         targets = api_checks.targets(targets, len(self.constrained))
+        if initial is not None:
+            initial = api_checks.initial(initial, len(self.V))
         self.prepare()
         # the move test's scale spans the targets too: a handle sent a thousand diagonals
         # away moves vertices by more than the rest mesh's size in every converging step

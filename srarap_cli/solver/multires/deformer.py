@@ -258,6 +258,8 @@ class MultiresDeformer:
         ``time_limit`` hold for each level). Returns a :class:`MultiresResult`."""
         begin = time.perf_counter()
         targets = api_checks.targets(targets, len(self.constrained))
+        if initial is not None:
+            initial = api_checks.initial(initial, len(self.V))
         if initial is not None and self.mode == "refine":
             return self._warm(targets, initial, callback, tol, accel, begin,
                               max_iter=max_iter, time_limit=time_limit, start=start)
