@@ -33,7 +33,9 @@ class EnergyHessian:
     state (see the module's text), and with ``Q_wu``'s transpose.
 
     Per-edge values are kept as (3, m) rows: the products gather, cross and sum contiguous
-    rows (three times faster than on (m, 3) arrays at 69k edges).
+    rows (three times faster than on (m, 3) arrays at 69k edges), a block of edges at a time
+    (:meth:`CellGraph.edge_blocks`: whole, the temporaries took 290 bytes an edge, 317 MB at
+    184k vertices).
 
     Attributes
     ----------
@@ -43,6 +45,7 @@ class EnergyHessian:
     n: int
     _I: np.ndarray
     _J: np.ndarray
+    _blocks: list          # slices of edges
     _ca: np.ndarray        # (3, m) c_ij a_ij
     _ca_sums: np.ndarray   # (n, 3) sum_j c_ij a_ij
     _cells: np.ndarray     # (n, 3, 3) membrane blocks plus the bending diagonal
@@ -53,25 +56,35 @@ class EnergyHessian:
         """``Q_ww v`` for rotor increments ``v`` (n, 3): (n, 3)."""
         out = np.einsum("nab,nb->na", self._cells, v)
         rows = np.ascontiguousarray(v.T)
-        # vec(v D) = d_w v + v x d for a pure quaternion v, vec(v D~) = d_w v - v x d
-        vj = np.take(rows, self._J, axis=1)
-        out -= self._sum(self._beta_w * vj + _cross(vj, self._beta_v), self._I)
-        vi = np.take(rows, self._I, axis=1)
-        out -= self._sum(self._beta_w * vi - _cross(vi, self._beta_v), self._J)
+        for e in self._blocks:
+            I, J, w, d = self._I[e], self._J[e], self._beta_w[e], self._beta_v[:, e]
+            # vec(v D) = d_w v + v x d for a pure quaternion v, vec(v D~) = d_w v - v x d
+            vj = np.take(rows, J, axis=1)
+            out -= self._sum(w * vj + _cross(vj, d), I)
+            vi = np.take(rows, I, axis=1)
+            out -= self._sum(w * vi - _cross(vi, d), J)
         return out
 
     def coupling(self, u: np.ndarray) -> np.ndarray:
         """``Q_wu u`` for position increments ``u`` (n, 3): (n, 3) on the rotors."""
-        uj = np.take(np.ascontiguousarray(u.T), self._J, axis=1)
-        return np.cross(self._ca_sums, u) - self._sum(_cross(self._ca, uj), self._I)
+        rows = np.ascontiguousarray(u.T)
+        out = np.cross(self._ca_sums, u)
+        for e in self._blocks:
+            out -= self._sum(_cross(self._ca[:, e], np.take(rows, self._J[e], axis=1)),
+                             self._I[e])
+        return out
 
     def coupling_t(self, v: np.ndarray) -> np.ndarray:
         """``Q_uw v`` for rotor increments ``v`` (n, 3): (n, 3) on the positions."""
-        vi = np.take(np.ascontiguousarray(v.T), self._I, axis=1)
-        return self._sum(_cross(self._ca, vi), self._J) - np.cross(self._ca_sums, v)
+        rows = np.ascontiguousarray(v.T)
+        out = -np.cross(self._ca_sums, v)
+        for e in self._blocks:
+            out += self._sum(_cross(self._ca[:, e], np.take(rows, self._I[e], axis=1)),
+                             self._J[e])
+        return out
 
     def _sum(self, rows, labels):
-        """Per-vertex sums (n, 3) of per-edge rows (3, m) by ``labels``."""
+        """Per-vertex sums (n, 3) of per-edge rows (3, k) by ``labels``."""
         return np.column_stack([np.bincount(labels, r, self.n) for r in rows])
 
 
@@ -106,31 +119,34 @@ def energy_hessian(graph, edges, P, R, bending_weight):
     >>> bool(np.abs(H.coupling(u)).max() < 1e-15)
     True
     """
-    I, J, c = graph.I, graph.J, graph.c
-    n = graph.n
+    n, m = graph.n, graph.I.size
     Rm = to_matrix(R)
     A = Rm @ edges.rest_moment @ Rm.transpose(0, 2, 1)
     C = A - edges.cross(P) @ Rm.transpose(0, 2, 1)
     trace = np.einsum("nii->n", C)
     cells = (edges.rest_scale - trace)[:, None, None] * np.eye(3) - A + 0.5 * (
         C + C.transpose(0, 2, 1))
-    # per-edge work on (k, m) rows: contiguous gathers and products
-    rows = np.ascontiguousarray(R.T)
-    Ri, Rj = np.take(rows, I, axis=1), np.take(rows, J, axis=1)
-    dots = np.einsum("km,km->m", Ri, Rj)
-    beta = bending_weight / 4.0 / np.take(graph.degree, I)
-    # D = s R_j R_i~ with s the sign that aligns the pair: scalar |R_i.R_j|, vector
-    # s (w_i v_j - w_j v_i + v_i x v_j)
-    beta_w = beta * np.abs(dots)
-    beta_v = (beta * np.where(dots < 0, -1.0, 1.0)) * (
-        Ri[0] * Rj[1:] - Rj[0] * Ri[1:] + _cross(Ri[1:], Rj[1:]))
-    cells += (np.bincount(I, beta_w, n) + np.bincount(J, beta_w, n))[:, None, None] * np.eye(3)
-    # a = R_i q R_i~: t = 2 v x q, a = q + w t + v x t
-    q = np.ascontiguousarray(edges.q.T)
-    t = 2.0 * _cross(Ri[1:], q)
-    a = q + Ri[0] * t + _cross(Ri[1:], t)
-    return EnergyHessian(n, I, J, c * a, np.einsum("nab,nb->na", Rm, edges.sum_cq), cells,
-                         beta_w, beta_v)
+    rows, rest = np.ascontiguousarray(R.T), np.ascontiguousarray(edges.rest_positions.T)
+    ca, beta_w, beta_v = np.empty((3, m)), np.empty(m), np.empty((3, m))
+    blocks = graph.edge_blocks()
+    for e in blocks:
+        I, J = graph.I[e], graph.J[e]
+        Ri, Rj = np.take(rows, I, axis=1), np.take(rows, J, axis=1)
+        dots = np.einsum("km,km->m", Ri, Rj)
+        beta = bending_weight / 4.0 / np.take(graph.degree, I)
+        # D = s R_j R_i~ with s the sign that aligns the pair: scalar |R_i.R_j|, vector
+        # s (w_i v_j - w_j v_i + v_i x v_j)
+        beta_w[e] = beta * np.abs(dots)
+        beta_v[:, e] = (beta * np.where(dots < 0, -1.0, 1.0)) * (
+            Ri[0] * Rj[1:] - Rj[0] * Ri[1:] + _cross(Ri[1:], Rj[1:]))
+        # a = R_i q R_i~: t = 2 v x q, a = q + w t + v x t
+        q = np.take(rest, J, axis=1) - np.take(rest, I, axis=1)
+        t = 2.0 * _cross(Ri[1:], q)
+        ca[:, e] = graph.c[e] * (q + Ri[0] * t + _cross(Ri[1:], t))
+    cells += (np.bincount(graph.I, beta_w, n) + np.bincount(graph.J, beta_w, n))[
+        :, None, None] * np.eye(3)
+    return EnergyHessian(n, graph.I, graph.J, blocks, ca,
+                         np.einsum("nab,nb->na", Rm, edges.sum_cq), cells, beta_w, beta_v)
 
 
 def _cross(a, b):

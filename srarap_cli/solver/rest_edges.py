@@ -48,6 +48,11 @@ class RestEdges:
         return self.deformed(self._V)
 
     @property
+    def rest_positions(self):
+        """The rest positions (n, 3) the edges were taken from."""
+        return self._V
+
+    @property
     def rest_moment(self):
         """``T_i = sum_j c_ij q_ij q_ij^T``: (n, 3, 3), the covariance of the rest shape."""
         return self.cross(self._V)
