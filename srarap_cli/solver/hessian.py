@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .quaternion import to_matrix
+from .group_rotations import label_sum
+from .quaternion import rotate, to_matrix
 
 
 @dataclass
@@ -85,7 +86,7 @@ class EnergyHessian:
 
     def _sum(self, rows, labels):
         """Per-vertex sums (n, 3) of per-edge rows (3, k) by ``labels``."""
-        return np.column_stack([np.bincount(labels, r, self.n) for r in rows])
+        return label_sum(rows.T, labels, self.n)
 
 
 def energy_hessian(graph, edges, P, R, bending_weight):
@@ -139,10 +140,8 @@ def energy_hessian(graph, edges, P, R, bending_weight):
         beta_w[e] = beta * np.abs(dots)
         beta_v[:, e] = (beta * np.where(dots < 0, -1.0, 1.0)) * (
             Ri[0] * Rj[1:] - Rj[0] * Ri[1:] + _cross(Ri[1:], Rj[1:]))
-        # a = R_i q R_i~: t = 2 v x q, a = q + w t + v x t
         q = np.take(rest, J, axis=1) - np.take(rest, I, axis=1)
-        t = 2.0 * _cross(Ri[1:], q)
-        ca[:, e] = graph.c[e] * (q + Ri[0] * t + _cross(Ri[1:], t))
+        ca[:, e] = graph.c[e] * rotate(Ri.T, q.T).T
     cells += (np.bincount(graph.I, beta_w, n) + np.bincount(graph.J, beta_w, n))[
         :, None, None] * np.eye(3)
     return EnergyHessian(n, graph.I, graph.J, blocks, ca,

@@ -68,4 +68,4 @@ def extrapolated_start(step, initial):
 def _arrays(initial):
     if initial is None:
         raise ValueError("a warm start needs initial=(positions, rotors)")
-    return np.array(initial[0], dtype=float), np.array(initial[1], dtype=float)
+    return np.asarray(initial[0], dtype=float), np.asarray(initial[1], dtype=float)
