@@ -1,6 +1,7 @@
 """Both factorization back ends solve the same systems."""
 import igl
 import numpy as np
+import pytest
 import scipy.sparse as sp
 from helpers import ends, tube
 
@@ -92,18 +93,38 @@ def test_restricted_order_is_the_mesh_order_of_the_rows():
     assert np.all(np.diff(rank[rows[sub]]) > 0)
 
 
-def test_an_approximate_factor_is_single_precision_and_answers_in_double(monkeypatch):
+@pytest.mark.parametrize("large", [0, linalg.LARGE])  # nested dissection, minimum degree
+def test_an_approximate_factor_is_single_precision_and_answers_in_double(monkeypatch, large):
     rng = np.random.default_rng(3)
     M = sp.random(40, 40, density=0.2, random_state=4)
     A = (M @ M.T + sp.eye(40)).tocsr()
     b = rng.standard_normal((40, 4))
-    monkeypatch.setattr(linalg, "LARGE", 0)
+    monkeypatch.setattr(linalg, "LARGE", large)
     x = linalg.factor(A, symmetric=True, approximate=True)(b)
     exact = linalg.factor(A, symmetric=True)(b)
     assert x.dtype == np.float64
     error = np.abs(x - exact).max() / np.abs(exact).max()
     assert 1e-12 < error < 1e-5  # single precision: neither exact nor far off
 
+
+
+@pytest.mark.parametrize("large", [0, linalg.LARGE])
+@pytest.mark.parametrize("matrix_scale, rhs_scale", [(1e-45, 1.0), (1e40, 1.0), (1.0, 1e-300),
+                                                     (1e-30, 1e200), (1e35, 1e-40)])
+def test_an_approximate_factor_solves_at_scales_single_precision_cannot_hold(
+        monkeypatch, large, matrix_scale, rhs_scale):
+    # a mesh in other units scales its matrices: 1e-45 and 1e40 lie outside float32's range
+    # (and 1e-300 far below it), yet the solve must still be the exact one to single precision
+    rng = np.random.default_rng(5)
+    M = sp.random(40, 40, density=0.2, random_state=6)
+    A = (M @ M.T + sp.eye(40)).tocsr()
+    b = rng.standard_normal((40, 4))
+    monkeypatch.setattr(linalg, "LARGE", large)
+    x = linalg.factor(A * matrix_scale, symmetric=True, approximate=True)(b * rhs_scale)
+    exact = linalg.factor(A, symmetric=True)(b) * (rhs_scale / matrix_scale)
+    assert np.isfinite(x).all()
+    assert np.abs(x - exact).max() < 1e-5 * np.abs(exact).max()
+    assert not linalg.factor(A, symmetric=True, approximate=True)(np.zeros((40, 4))).any()
 
 def _fill(A, order):
     import scipy.sparse.linalg as spla
