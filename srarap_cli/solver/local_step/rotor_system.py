@@ -15,7 +15,7 @@ iterations). The scalar matrix ``diag(tau_i + sigma_i m_i) - omega`` with ``m_i`
 membrane scale is factored once per mesh; applied to the four quaternion components it brings
 CG to 5 to 10 iterations on the shared meshes. It is factored in single precision (an
 approximate inverse is all CG asks of it): the same CG iterations, and its triangular solves,
-two per local step, read half the bytes (four columns at 50k vertices: 18 -> 11 ms).
+one per CG iteration, read half the bytes (four columns at 50k vertices: 18 -> 11 ms).
 
 The membrane blocks grow with the deformed edges: a handle moved 100 to 10^6 bounding-box
 diagonals away makes them 10^4 to 10^12 times their rest size, and a preconditioner built on the
