@@ -24,6 +24,7 @@ import scipy.sparse.linalg as spla
 
 from .hessian import energy_hessian
 from .linalg import factor
+from .local_step.linear_sym import symmetric_weights
 
 #: relative residual of the rotors' system: the prediction's error is then about 1% of the
 #: first-order change, far below the second-order error it leaves anyway
@@ -46,10 +47,10 @@ class LinearResponse:
     def __init__(self, deformer):
         self.deformer = deformer
         graph = deformer.graph
-        beta = deformer.bending_weight / 4.0 / graph.degree[graph.I]
+        # the bending pairs as the total-energy rotor system couples them (1/deg_i + 1/deg_j)
+        beta = deformer.bending_weight / 4.0 * symmetric_weights(graph)
         W = sp.csr_matrix((beta, (graph.I, graph.J)), shape=(graph.n,) * 2)
-        W = (W + W.T).tocsr()
-        diagonal = np.asarray(W.sum(axis=1)).ravel() + 2.0 / 3.0 * deformer.edges.rest_scale
+        diagonal = graph.cell_sum(beta) + 2.0 / 3.0 * deformer.edges.rest_scale
         # a vertex in no triangle has no energy: any value keeps its row solvable
         diagonal[diagonal <= 0] = 1.0
         M = (sp.diags(diagonal) - W).tocsr()

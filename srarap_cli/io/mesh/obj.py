@@ -308,9 +308,9 @@ def _fixed_text(mesh):
 
 
 def _face_text(mesh, offsets, first, stop):
-    """The ``f`` lines of polygons ``first:stop`` (at least one): in blocks of one polygon size (a quad
-    mesh's triangle caps, say), or line by line when the sizes alternate too often for
-    blocks to pay or the corners' forms differ."""
+    """The ``f`` lines of polygons ``first:stop`` (at least one): in blocks of one polygon
+    size (a quad mesh's triangle caps, say), or line by line when the sizes alternate too
+    often for blocks to pay or the corners' forms differ."""
     changes = first + 1 + np.flatnonzero(np.diff(mesh.face_sizes[first:stop]))
     if 64 * changes.size > stop - first:
         return _face_lines(mesh, offsets, first, stop)
