@@ -35,10 +35,9 @@ CASES = [
 def srarap_run(V, F, c, tol, method):
     opts = resolve(c.solver, {"tol": tol, "method": method})
     t0 = time.perf_counter()
-    d = Deformer(V, F, c.ids, alpha=opts.alpha, feedback=opts.feedback,
-                 weights=opts.weights, method=opts.method)
+    d = Deformer(V, F, c.ids, settings=opts)
     pre = time.perf_counter() - t0
-    r = d.solve(c.targets, max_iter=opts.max_iter, tol=tol)
+    r = d.solve(c.targets)
     per_iter = (r.log[-1]["seconds"] - r.log[0]["seconds"]) / max(r.iterations, 1)
     return pre, per_iter, r
 

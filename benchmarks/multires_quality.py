@@ -23,8 +23,10 @@ import numpy as np
 from srarap_cli import DeformResult
 from srarap_cli.io.handles import load_handles
 from srarap_cli.io.mesh import read_mesh
+from srarap_cli.solver.oneshot import make_deformer
 from srarap_cli.solver.settings import resolve
-from srarap_cli.tasks.pipeline import build_deformer, problem
+from srarap_cli.solver.stop import StopReason
+from srarap_cli.tasks.pipeline import problem
 
 
 def use_meshlab():
@@ -51,7 +53,7 @@ def refit_energy(direct, P, R):
 
 def run(p, opts, size, tol, max_iter):
     start = time.perf_counter()
-    d = build_deformer(p, opts.replace(multires=size))
+    d = make_deformer(p.V, p.F, p.ids, p.labels, settings=opts.replace(multires=size))
     r = d.solve(p.targets, max_iter=max_iter, tol=tol)
     return d, r, time.perf_counter() - start
 
@@ -59,10 +61,11 @@ def run(p, opts, size, tol, max_iter):
 def reference(p, opts, args):
     """The direct solve: computed, or read from ``args.reference`` (same inputs assumed)."""
     if args.reference and os.path.exists(args.reference):
-        direct = build_deformer(p, opts.replace(multires="off"))
+        direct = make_deformer(p.V, p.F, p.ids, p.labels, settings=opts.replace(multires="off"))
         with np.load(args.reference) as z:
             log = json.loads(str(z["log"]))
-            ref = DeformResult(z["positions"], z["rotors"], log, True, len(log) - 1)
+            ref = DeformResult(z["positions"], z["rotors"], log, StopReason.CONVERGED,
+                               len(log) - 1)
             return direct, ref, float(z["seconds"])
     direct, ref, seconds = run(p, opts, "off", args.tol, args.max_iter)
     if args.reference:

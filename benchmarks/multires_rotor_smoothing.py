@@ -35,7 +35,7 @@ def main():
         P_direct, e_direct = z["positions"], json.loads(str(z["log"]))[-1]["total"]
     diag = np.linalg.norm(np.ptp(p.V, axis=0))
     for size in args.sizes:
-        d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=size, mode="transfer")
+        d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=size, multires_mode="transfer")
         r = d.solve(p.targets, max_iter=5000, tol=1e-6)
         g = d.fine.graph
         W = sp.csr_matrix((np.ones(len(g.I)), (g.I, g.J)), shape=(g.n, g.n))

@@ -1,7 +1,9 @@
 """srarap: as-rigid-as-possible surface deformation with smooth rotations (linear-time SR-ARAP).
 
 Public API: :class:`Deformer` (precompute once, solve many times), :func:`deform` (one shot),
-:func:`read_mesh` / :func:`write_mesh`, :func:`load_handles`, :func:`deform_mesh`.
+:func:`read_mesh` / :func:`write_mesh`, :func:`load_handles`, :func:`deform_mesh`; the
+:class:`Settings` every solver reads, the :class:`Solver` interface both solvers satisfy, the
+:class:`StopReason` every result carries.
 
 The package is in layers, each importing only those below it: ``cli`` (the command line) ->
 ``tasks`` (what a command does) -> ``io`` (files) -> ``solver`` (the paper) -> ``runtime``
@@ -13,7 +15,8 @@ do not load the numerical stack.
 import importlib
 
 _WHERE = {"Constraints": "io.handles", "DeformResult": "solver.deformer",
-          "Deformer": "solver.deformer", "Mesh": "io.mesh", "deform": "tasks.api",
+          "Deformer": "solver.deformer", "Mesh": "io.mesh", "Settings": "solver.settings",
+          "Solver": "solver.interface", "StopReason": "solver.stop", "deform": "tasks.api",
           "deform_mesh": "tasks.pipeline", "load_handles": "io.handles", "read_mesh": "io.mesh",
           "write_mesh": "io.mesh"}
 

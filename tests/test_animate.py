@@ -37,8 +37,8 @@ def twist_doc(degrees=240, frames=24):
 def run_frames(mesh, doc, n, feedback, iters=20):
     c = parse_handles(doc, mesh.vertices)
     frames = []
-    state = Animator(mesh, c, resolve({}, {"feedback": feedback})).run(
-        n, max_iter=iters, tol=1e-6, on_frame=lambda f, P, s: frames.append(P))
+    state = Animator(mesh, c, resolve({"feedback": feedback, "max_iter": iters, "tol": 1e-6})).run(
+        n, on_frame=lambda f, P, s: frames.append(P))
     return c, frames, state.rows
 
 
@@ -66,9 +66,9 @@ def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames(rings, multir
                       for g, box in (("base", BASE["box"]), ("top", TOP_BOX))}}
     c = parse_handles(doc, mesh.vertices)
     frames = []
-    animator = Animator(mesh, c, resolve({}, {"multires": multires}))
+    animator = Animator(mesh, c, resolve({"multires": multires, "max_iter": 3000, "tol": 1e-13}))
     assert (multires == "off") == (animator.deformer.__class__.__name__ == "Deformer")
-    animator.run(4, max_iter=3000, tol=1e-13, on_frame=lambda f, P, s: frames.append(P))
+    animator.run(4, on_frame=lambda f, P, s: frames.append(P))
     q1 = from_axis_angle([1, 1, 0], 90)
     for f, P in enumerate(frames):
         t = f / 3

@@ -52,8 +52,9 @@ def test_sample_case_converges_and_keeps_uvs_and_polygons(tmp_path):
     with open(log) as fh:
         rows = list(csv.DictReader(fh))
     assert list(rows[0]) == ["iteration", "membrane", "bending", "total", "rel_change",
-                             "max_move", "seconds", "step"]
+                             "max_move", "seconds", "step", "stop"]
     assert float(rows[-1]["rel_change"]) <= 1e-6 and "converged" in r.stderr
+    assert [row["stop"] for row in rows] == [""] * (len(rows) - 1) + ["converged"]
 
 
 def test_same_inputs_give_byte_identical_output(small, tmp_path):

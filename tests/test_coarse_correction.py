@@ -101,5 +101,5 @@ def test_a_coarse_mesh_above_the_threshold_is_solved_through_a_coarser_one(monke
     assert {"coarse-coarse-start", "coarse-corrected", "corrected"} <= steps
     assert nested.converged and nested.energy <= direct.energy * (1 + 1e-5)
     assert np.abs(nested.positions - direct.positions).max() < 1e-3 * diagonal(V)
-    transfer = MultiresDeformer(V, F, ids, size=500, mode="transfer")
+    transfer = MultiresDeformer(V, F, ids, size=500, multires_mode="transfer")
     assert not isinstance(transfer.coarse_deformer, MultiresDeformer)

@@ -147,7 +147,7 @@ def test_multires_solve_follows_the_handles_and_logs_its_stages(spot):
     V = spot[0]
     c = load_handles(NOD, V)
     p = problem(read_mesh(SPOT), c)
-    d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500, mode="transfer")
+    d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500, multires_mode="transfer")
     r = d.solve(p.targets, max_iter=400)
     assert np.array_equal(r.positions[p.ids], p.targets)
     assert set(r.stages) == {"simplify", "coarse_precompute", "factor", "coarse_solve",
@@ -274,7 +274,7 @@ def test_one_fine_factorization_serves_transfer_and_final_solve_for_every_pose(
     real = module.DirichletSolver
     monkeypatch.setattr(module, "DirichletSolver", lambda *a: built.append(1) or real(*a))
     V, F = igl.loop(*igl.loop(*_octahedron()))
-    d = MultiresDeformer(V, F, np.arange(6), size=30, mode=mode)
+    d = MultiresDeformer(V, F, np.arange(6), size=30, multires_mode=mode)
     for shift in (0.5, 1.0, 1.5):
         d.solve(V[:6] + shift, max_iter=5)
     assert len(built) == factorizations
@@ -287,11 +287,13 @@ def test_the_summary_counts_what_the_log_holds_and_reports_wall_seconds(tmp_path
 
     from srarap_cli.io.handles import load_handles
     from srarap_cli.io.mesh import read_mesh
+    from srarap_cli.solver.settings import resolve
     from srarap_cli.tasks.pipeline import deform_mesh
 
     mesh = read_mesh(SPOT)
     start = time.perf_counter()
-    _, result, _ = deform_mesh(mesh, load_handles(NOD, mesh.vertices), multires=2000)
+    handles = load_handles(NOD, mesh.vertices)
+    _, result, _ = deform_mesh(mesh, handles, resolve(handles.solver, {"multires": 2000}))
     wall = time.perf_counter() - start
     steps = [row["step"] for row in result.log]
     coarse_rows = sum(s.startswith("coarse-") and not s.endswith("start") for s in steps)

@@ -90,7 +90,7 @@ def test_standard_input_and_output_with_formats(folder):
                            stdin=fh, capture_output=True, timeout=300)
     assert p.returncode == 0 and p.stdout == (folder / "ref.obj").read_bytes()
     assert b"wrote <stdout>" in p.stderr
-    for args, code in ((["--input-format", "ply"], 4), ([], 2)):
+    for args, code in ((["--input-format", "ply"], 4), ([], 4)):
         bad = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "-", "h.yaml", "-o",
                               "-", "--format", "ply", *args], cwd=folder, input=b"garbage",
                              capture_output=True, timeout=300)

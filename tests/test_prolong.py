@@ -56,7 +56,7 @@ def test_the_refine_start_is_closer_to_the_minimum_than_the_papers_transfer():
     T = twist(V, ids, 10.0, 120)
     best = Deformer(V, F, ids).solve(T, tol=1e-9, max_iter=3000).energy
     refined = MultiresDeformer(V, F, ids, size=300).solve(T, tol=1e-6)
-    paper = MultiresDeformer(V, F, ids, size=300, mode="transfer").solve(T, tol=1e-6)
+    paper = MultiresDeformer(V, F, ids, size=300, multires_mode="transfer").solve(T, tol=1e-6)
     fine = [row for row in refined.log if not row["step"].startswith("coarse")]
     assert fine[1]["total"] < paper.energy
     assert fine[1]["total"] < 1.1 * best

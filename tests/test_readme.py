@@ -57,6 +57,11 @@ def test_the_options_table_is_the_settings_table():
     assert markdown_table() in Path(ROOT, "README.md").read_text(encoding="utf-8")
 
 
+def test_the_formats_table_is_the_format_registry():
+    from srarap_cli.io.mesh.formats import markdown_table
+    assert markdown_table() in Path(ROOT, "README.md").read_text(encoding="utf-8")
+
+
 def test_the_readme_stays_a_front_door():
     assert len(Path(ROOT, "README.md").read_bytes()) <= 25_000
 

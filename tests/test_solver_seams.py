@@ -16,6 +16,7 @@ from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 from srarap_cli.solver.settings import SETTINGS, parse_mapping
 from srarap_cli.solver.starts import STARTS
 from srarap_cli.solver.starts import register as register_start
+from srarap_cli.solver.stop import StopReason
 
 
 @pytest.fixture(scope="module")
@@ -136,6 +137,8 @@ def test_library_entry_points_take_every_solver_keyword(bent):
 
 def test_time_limit_stops_a_solve_not_converged(bent):
     V, F, ids, T = bent
-    r = Deformer(V, F, ids).solve(T, max_iter=100000, tol=-1, time_limit=0.3)  # tol: never
+    # tol 0: no stopping test, only the iteration count and the clock
+    r = Deformer(V, F, ids).solve(T, max_iter=100000, tol=0, time_limit=0.3)
     assert not r.converged and 0 < r.iterations < 100000
+    assert r.stop_reason is StopReason.TIME_LIMIT and not r.complete
     assert r.log[-1]["seconds"] >= 0.3

@@ -9,13 +9,15 @@ import time
 import click
 
 from ..io.handles import load_handles, referenced_files
-from ..io.mesh import WRITE_FORMATS, frame_formatter, read_mesh
+from ..io.mesh import frame_formatter, read_mesh
+from ..io.mesh.formats import extensions
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..runtime.errors import InputError, OutputError
 from ..runtime.limits import check_solve
 from ..solver.settings import resolve
+from ..solver.stop import StopReason
 from ..tasks.animation import FRAME_FIELDS, Animator, FrameState, fingerprint
 from .common import (
     cache_option,
@@ -52,7 +54,7 @@ MAX_FRAMES = 100_000
               help="Write a frame that did not converge and go on (exit code still 3).")
 @click.option("--log", "log", help="Per-frame log: .csv or .jsonl.")
 @click.option("--resume", is_flag=True, help="Continue after the last complete frame.")
-@settings_options(exclude=("time_limit",))
+@settings_options()
 @cache_option
 @with_verbosity
 @guarded
@@ -61,10 +63,11 @@ def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, ke
     """Deform MESH through the keyframes of HANDLES, writing one mesh per frame.
 
     Each frame starts from the frames before it and iterates to --tol (at most --max-iter
-    iterations). Frames are written atomically; --resume continues an interrupted run and
-    gives the same files as an uninterrupted one. Exit codes: 0 every frame converged and was
-    written; 3 a frame did not converge: the sequence stops before it (frames so far and the
-    log are written; --keep-unconverged writes it and goes on). With --iters-per-frame N
+    iterations and --time-limit seconds a frame). Frames are written atomically; --resume
+    continues an interrupted run and gives the same files as an uninterrupted one. Exit
+    codes: 0 every frame converged and was written; 3 a frame did not converge: the sequence
+    stops before it (frames so far and the log are written; --keep-unconverged writes it and
+    goes on). With --iters-per-frame N
     (fixed budget) every frame is written and the exit code is 0.
     """
     folder = _check_pattern(pattern)
@@ -91,8 +94,8 @@ def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, ke
         progress.update(f + 1)
 
     budget = iters_per_frame is not None
-    final = animator.run(n_frames, max_iter=iters_per_frame if budget else opts.max_iter,
-                         tol=opts.tol, stop_unconverged=not (budget or keep_unconverged),
+    final = animator.run(n_frames, max_iter=iters_per_frame,
+                         stop_unconverged=not (budget or keep_unconverged),
                          state=state, on_frame=write_frame, fingerprint=run_id)
     progress.close()
     rows = final.rows if final is not None else []
@@ -106,13 +109,14 @@ def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, ke
         os.unlink(state_path)
     report(verbosity, warnings=animator.warnings,
            details=animator.last_result.report_lines() if animator.last_result else [],
-           summary=_summary(rows, state, n_frames, pattern, stopped, iters_per_frame, opts))
+           summary=_summary(rows, state, n_frames, pattern, stopped, iters_per_frame,
+                            animator.last_result))
     unconverged = sum(not r["converged"] for r in rows)
     if unconverged and not budget:
         raise SystemExit(exit_codes.NOT_CONVERGED)
 
 
-def _summary(rows, state, n_frames, pattern, stopped, budget, opts):
+def _summary(rows, state, n_frames, pattern, stopped, budget, result):
     first = 0 if state is None else state.frame + 1
     last = n_frames - 1 if stopped is None else stopped - 1
     wrote = (f"wrote {pattern.format(first)} .. {pattern.format(last)}" if first <= last
@@ -127,8 +131,11 @@ def _summary(rows, state, n_frames, pattern, stopped, budget, opts):
             + (f", median {its[len(its) // 2]} iterations" if its else "")
             + f"; {len(rows) / max(seconds, 1e-9):.2f} frames/s; {wrote}")
     if stopped is not None:
-        head += (f"; STOPPED at frame {stopped}: not converged in {opts.max_iter} iterations "
-                 "(raise --max-iter, or --keep-unconverged writes it and goes on)")
+        reason = result.stop_reason
+        limit = "--time-limit" if reason is StopReason.TIME_LIMIT else "--max-iter"
+        head += (f"; STOPPED at frame {stopped}: not converged in {result.iterations} "
+                 f"iterations ({reason}: {result.stop_detail}; raise {limit}, or "
+                 "--keep-unconverged writes it and goes on)")
     return head
 
 
@@ -172,9 +179,9 @@ def _check_pattern(pattern):
     if os.path.dirname(a) != os.path.dirname(b):
         raise click.UsageError(f"-o {pattern!r}: the frame number must be in the file name, "
                                "not in a folder")
-    if _suffix(pattern) not in WRITE_FORMATS:
+    if _suffix(pattern) not in extensions():
         raise click.UsageError(f"-o {pattern!r}: extension must be one of "
-                               f"{', '.join(WRITE_FORMATS)}")
+                               f"{', '.join(extensions())}")
     folder = os.path.dirname(os.path.abspath(a))
     try:
         os.makedirs(folder, exist_ok=True)

@@ -53,12 +53,10 @@ def bench(mesh, handles, methods, time_budget, out, overrides):
     source = read_mesh(mesh)
     check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
-    stop = {k: v if overrides[k] is None else overrides[k] for k, v in OWN_DEFAULTS.items()}
-    opts = resolve(constraints.solver, {k: v for k, v in overrides.items() if k not in stop})
+    opts = resolve(constraints.solver, OWN_DEFAULTS, overrides)
     p = problem(source, constraints, mesh)
     runs = run_methods(p.V, p.F, p.ids, p.targets, names, settings=opts,
-                       time_budget=time_budget, max_iter=stop["max_iter"], tol=stop["tol"],
-                       sweeps=opts.sweeps)
+                       time_budget=time_budget)
     click.echo(table(runs), nl=False)
     if out is not None:
         info = {"mesh": mesh, "handles": handles, "vertices": len(p.V),

@@ -3,7 +3,6 @@ import functools
 import math
 import os
 import sys
-import tempfile
 import traceback
 from collections import Counter
 
@@ -11,7 +10,9 @@ import click
 import numpy as np
 
 from ..io.handles import referenced_files
-from ..io.mesh import read_mesh
+from ..io.mesh import FORMATS, MeshFormat, read_mesh
+from ..io.mesh.formats import by_extension
+from ..io.mesh.stream import read_mesh_stream
 from ..runtime import exit_codes, signals, streams
 from ..runtime.clock import elapsed
 from ..runtime.commit import COMMITTED
@@ -187,29 +188,37 @@ def refuse_overwrite(outputs, *, mesh=None, handles=None, others=()):
                               inputs + list(others))
 
 
-def read_stdin_mesh(input_format):
-    """The mesh on standard input, parsed by the reader of ``input_format``."""
-    if input_format is None:
-        raise click.UsageError("MESH '-' (standard input) needs --input-format obj|off|ply|stl")
-    data = sys.stdin.buffer.read()
-    with tempfile.TemporaryDirectory(prefix="srarap-stdin-") as folder:
-        path = os.path.join(folder, "stdin." + input_format)
-        with open(path, "wb") as fh:
-            fh.write(data)
-        try:
-            return read_mesh(path)
-        except InputError as exc:
-            raise InputError(str(exc).replace(path, "<stdin>")) from None
-
-
 def read_any_mesh(path, input_format=None):
-    """``path``, or standard input for ``-`` (in ``input_format``)."""
-    return read_stdin_mesh(input_format) if path == "-" else read_mesh(path)
+    """``(mesh, format)``: the file ``path`` (by its extension), or standard input for ``-``
+    (as ``input_format``, a :class:`~srarap_cli.io.mesh.MeshFormat`, or the format its bytes
+    show)."""
+    if path == "-":
+        return read_mesh_stream(sys.stdin.buffer if sys.stdin else None, input_format)
+    return read_mesh(path), by_extension(path)
+
+
+class MeshFormatType(click.ParamType):
+    """A registered mesh format's name, as its :class:`~srarap_cli.io.mesh.MeshFormat`;
+    the choices are read from the format table when used, so a format registered after
+    this module was imported is one too."""
+
+    name = "format"
+
+    def get_metavar(self, param, ctx):
+        return "[" + "|".join(FORMATS) + "]"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, MeshFormat):
+            return value
+        fmt = FORMATS.get(str(value).lower())
+        if fmt is None:
+            self.fail(f"{value!r} is not one of {', '.join(map(repr, FORMATS))}", param, ctx)
+        return fmt
 
 
 input_format_option = click.option(
-    "--input-format", type=click.Choice(["obj", "off", "ply", "stl"]),
-    help="Format of a mesh given as '-' (standard input).")
+    "--input-format", type=MeshFormatType(),
+    help="Format of a mesh given as '-' (standard input). [default: told from its bytes]")
 
 
 cache_option = click.option("--cache", type=click.Path(file_okay=False),

@@ -31,7 +31,7 @@ def compare(a, b, tol, relative, report, quiet, input_format):
     refuse_overwrite([report], others=[("mesh A", a), ("mesh B", b)])
     if a == b == "-":
         raise click.UsageError("only one of A and B can be '-' (standard input)")
-    ma, mb = read_any_mesh(a, input_format), read_any_mesh(b, input_format)
+    ma, mb = read_any_mesh(a, input_format)[0], read_any_mesh(b, input_format)[0]
     figures = compare_meshes(ma, mb)
     scale = figures["diagonal"] if relative and figures["diagonal"] > 0 else 1.0
     shown = {k: figures[k] / scale for k in ("max", "mean", "rms")}

@@ -6,18 +6,20 @@ import sys
 import click
 
 from ..io.handles import load_handles
-from ..io.mesh import WRITE_FORMATS, format_mesh
+from ..io.mesh import FORMATS
+from ..io.mesh.formats import by_extension, extensions
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..runtime.limits import check_solve
-from ..solver.drivers.monitor import recent_changes
 from ..solver.multires.size import AUTO_THRESHOLD
-from ..solver.settings import complete, resolve
+from ..solver.settings import resolve
+from ..solver.stop import StopReason
 from ..tasks.distortion import vertex_distortion
 from ..tasks.pipeline import deform_mesh
 from ..tasks.preview import preview_png
 from .common import (
+    MeshFormatType,
     cache_option,
     check_output_path,
     guarded,
@@ -37,13 +39,14 @@ from .progress import SolveProgress
 @click.argument("mesh")
 @click.argument("handles")
 @click.option("-o", "--output", "out", required=True,
-              help="Deformed mesh to write: .obj, .ply, .off or .stl (binary); '-' for "
-                   "standard output.")
+              help="Deformed mesh to write, in the format of its extension (see --format); "
+                   "'-' for standard output.")
 @input_format_option
-@click.option("--format", "out_format", type=click.Choice(["obj", "off", "ply", "stl"]),
+@click.option("--format", "out_format", type=MeshFormatType(),
               help="Format of the output when it is '-' (standard output). [default: the "
                    "input's format]")
-@click.option("--ascii", is_flag=True, help="Write PLY as ASCII text (default: binary).")
+@click.option("--ascii", is_flag=True,
+              help="Write the text variant of a format that has one (PLY; default: binary).")
 @click.option("--log", "log",
               help="Per-iteration energy log: .csv or .jsonl.")
 @settings_options()
@@ -65,36 +68,37 @@ def deform(mesh, handles, out, input_format, out_format, ascii, log, overrides, 
     Exit codes: 0 converged, 3 not converged (no mesh written unless --keep-unconverged; the
     log is written), 2 usage, 4 invalid input, 5 numerical failure, 6 output error.
     """
-    suffix = _output_suffix(out, out_format, mesh, input_format)
-    if ascii and suffix != ".ply":
-        raise click.UsageError("--ascii applies to PLY output only")
+    fmt = _output_format(out, out_format, mesh)
+    if fmt is not None:
+        _check_format_options(fmt, ascii, write_distortion)
     if out != "-":
-        check_output_path(out, WRITE_FORMATS, "output")
+        check_output_path(out, extensions(), "output")
     if preview is not None:
         check_output_path(preview, (".png",), "preview")
-    if write_distortion and suffix != ".ply":
-        raise click.UsageError("--write-distortion needs a .ply output")
     if log is not None:
         check_output_path(log, LOG_FORMATS, "log")
         if os.path.abspath(log) == os.path.abspath(out):
             raise click.UsageError("--log and --output name the same file")
     refuse_overwrite([out, log, preview], mesh=mesh, handles=handles)
-    source = read_any_mesh(mesh, input_format)
+    source, source_format = read_any_mesh(mesh, input_format)
+    if fmt is None:
+        fmt = source_format
+        _check_format_options(fmt, ascii, write_distortion)
     name = "<stdin>" if mesh == "-" else mesh
     check_solve(name, len(source.vertices))
     constraints = load_handles(handles, source.vertices)
     opts = resolve(constraints.solver, overrides)
     progress = SolveProgress(enabled=verbosity != 0 and sys.stderr.isatty())
     try:
-        deformed, result, notes = deform_mesh(source, constraints, callback=progress,
-                                              cache=cache, name=name, settings=opts)
+        deformed, result, notes = deform_mesh(source, constraints, opts, callback=progress,
+                                              cache=cache, name=name)
     finally:
         progress.close()
     if write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
-    done = complete(result, opts)
-    mesh_bytes, lost = format_mesh(deformed, suffix, ascii)
+    done = result.complete
+    mesh_bytes, lost = fmt.write(deformed, ascii)
     keep = done or keep_unconverged
     files = [(out, mesh_bytes)] if keep and out != "-" else []
     if preview is not None and keep:
@@ -112,58 +116,57 @@ def deform(mesh, handles, out, input_format, out_format, ascii, log, overrides, 
         raise SystemExit(exit_codes.NOT_CONVERGED)
 
 
-def _output_suffix(out, out_format, mesh, input_format):
+def _output_format(out, out_format, mesh):
+    """The output's MeshFormat: ``--format``, or the extension of ``out``; for ``-o -``
+    without ``--format``, the input file's, or None for standard input (its bytes decide)."""
     if out == "-":
-        given = out_format or (input_format if mesh == "-" else
-                               os.path.splitext(mesh)[1].lower().lstrip("."))
-        if "." + str(given) not in WRITE_FORMATS:
-            raise click.UsageError("-o - (standard output) needs --format obj|off|ply|stl")
-        return "." + given
-    if out_format is not None and os.path.splitext(out)[1].lower() != "." + out_format:
-        raise click.UsageError(f"--format {out_format} does not match the output {out!r}")
-    return os.path.splitext(out)[1].lower()
+        return out_format or (None if mesh == "-" else by_extension(mesh))
+    fmt = by_extension(out)
+    if out_format is not None and fmt is not out_format:
+        raise click.UsageError(f"--format {out_format.name} does not match the output {out!r}")
+    return fmt
+
+
+def _check_format_options(fmt, ascii, write_distortion):
+    if ascii and not fmt.has_ascii:
+        raise click.UsageError(f"--ascii applies to {_having('has_ascii')} output only")
+    if write_distortion and not fmt.keeps_vertex_data:
+        raise click.UsageError(f"--write-distortion needs a {_having('keeps_vertex_data')} "
+                               "output")
+
+
+def _having(attribute):
+    """The names of the formats with ``attribute`` set, for a message: ``PLY``."""
+    return "/".join(f.name.upper() for f in FORMATS.values() if getattr(f, attribute))
 
 
 def _summary(result, opts, out):
-    """The one summary line: what passed the stopping test (at full resolution), the
+    """The one summary line: why the solve stopped (at full resolution), the
     full-resolution and coarse iterations apart, the energy, the process's wall seconds."""
     coarse = f" (+ {result.coarse_iterations} coarse)" if result.coarse_iterations else ""
     e = result.energies()
     energy = (f"energy {e['total']:.6g} (membrane {e['membrane']:.6g}, bending "
               f"{e['bending']:.6g})")
+    reason = result.stop_reason
     if result.approximate:
         state = (f"approximate (multires transfer: coarse solve "
                  f"{'converged' if result.coarse_converged else 'NOT converged'} in "
                  f"{result.coarse_iterations} iterations, none at full resolution)")
         energy = f"full-resolution {energy}, {result.start_energy['total']:.6g} at the start"
-    elif result.converged:
+    elif reason is StopReason.CONVERGED:
         state = f"converged in {result.iterations} full-resolution iterations{coarse}"
-    elif complete(result, opts):
+    elif reason is StopReason.ITERATIONS_RUN:
         state = f"ran the {result.iterations} iterations asked (tol 0){coarse}"
     else:
         state = (f"NOT converged after {result.iterations} full-resolution iterations{coarse} "
-                 f"({_why(result.log, opts)}; {_advice(result, opts)})")
+                 f"({reason}: {result.stop_detail}; {_advice(result, opts)})")
     return (f"srarap deform: {state}; {energy}; {wall_seconds(result):.2f} s; "
             + (f"wrote {out}" if out else "no mesh written (--keep-unconverged writes it)"))
 
 
-
-def _why(log, opts):
-    """Which stopping test failed, with the numbers it compared (see drivers.monitor)."""
-    changes = recent_changes(log)
-    if not changes:
-        return "no iteration ran"
-    mean = sum(changes) / len(changes)
-    if mean > opts.tol:
-        return (f"relative change {mean:.3g} per step over the last {len(changes)} > "
-                f"tol {opts.tol:g}")
-    return (f"relative change {mean:.3g} per step but the last step still moved a vertex by "
-            f"{log[-1]['max_move']:.3g}")
-
-
 def _advice(result, opts):
-    """What to try after a run that stopped unconverged, from how it stopped."""
-    if opts.time_limit is not None and result.seconds >= opts.time_limit:
+    """What to try after a run that stopped unconverged, from why it stopped."""
+    if result.stop_reason is StopReason.TIME_LIMIT:
         return f"stopped by --time-limit {opts.time_limit:g}: allow more time"
     tips = [f"raise --max-iter (was {opts.max_iter})"]
     n = len(result.positions)

@@ -20,7 +20,7 @@ def info(mesh, handles, input_format, as_json):
     The mesh: counts, extent per axis, problems. With HANDLES, each group's vertices and
     action: a dry run of the checks deform makes (exit 4 when the file is invalid).
     """
-    source = read_any_mesh(mesh, input_format)
+    source = read_any_mesh(mesh, input_format)[0]
     name = "<stdin>" if mesh == "-" else mesh
     out = {"mesh": name, **mesh_info(source)}
     if handles is not None:

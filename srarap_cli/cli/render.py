@@ -54,7 +54,7 @@ def render(mesh, out, handles, rest, color, layout, up, views, size, input_forma
         _check_view(view)
     refuse_overwrite([out], mesh=mesh, handles=handles,
                      others=[("rest mesh", rest)] if rest else [])
-    shown = read_any_mesh(mesh, input_format)
+    shown = read_any_mesh(mesh, input_format)[0]
     base = read_mesh(rest) if rest else None
     if base is not None and len(base.vertices) != len(shown.vertices):
         raise click.BadParameter("the rest mesh must have the same vertices", param_hint="--rest")

@@ -5,8 +5,10 @@ import json
 import math
 
 LOG_FORMATS = (".csv", ".jsonl", ".ndjson")
+#: ``stop``: empty but on the row where a solve (or a multiresolution level) stopped, which
+#: holds why (:class:`srarap_cli.solver.stop.StopReason`'s value)
 LOG_FIELDS = ("iteration", "membrane", "bending", "total", "rel_change", "max_move", "seconds",
-              "step")
+              "step", "stop")
 
 
 def format_log(rows, suffix, fields=LOG_FIELDS):

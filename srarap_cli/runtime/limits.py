@@ -11,10 +11,9 @@ import resource
 
 from .errors import InputError
 
-# Measured on this project's machines (README, "Limits"): parsing text meshes holds about 17x
-# the file size; an SR solve about 4 KB per vertex on a long bar, more where the
-# factorizations fill in. These carry a safety margin.
-READ_FACTOR = {".obj": 20, ".off": 20, ".ply": 6, ".stl": 6}
+# Measured on this project's machines (README, "Limits"): an SR solve takes about 4 KB per
+# vertex on a long bar, more where the factorizations fill in; this carries a safety margin.
+# (What parsing a file takes, per format, is the format table's read_factor: io.mesh.formats.)
 SOLVE_BYTES_PER_VERTEX = 8_000
 ENV = "SRARAP_MEMORY_LIMIT"
 #: coordinates beyond this would overflow when squared (energies, lengths): a typo, not a pose
@@ -108,15 +107,19 @@ def _refuse(what, need, have):
                      "change the assumption)")
 
 
-def check_read(path):
-    """Before reading: refuse a mesh file whose parsing would not fit."""
+def check_read(path, factor):
+    """Before reading: refuse a mesh file whose parsing would not fit, ``factor`` being the
+    bytes of memory parsing holds per byte of the file."""
     have = available_memory()
     if have is None or not os.path.isfile(path):
         return
-    factor = READ_FACTOR.get(os.path.splitext(str(path))[1].lower(), 20)
-    need = factor * os.path.getsize(path)
-    if need > have:
-        _refuse(f"{path}: reading it", need, have)
+    check_read_size(path, factor * os.path.getsize(path), have)
+
+
+def check_read_size(what, need, have):
+    """Refuse reading ``what`` when ``need`` bytes of memory exceed ``have`` (None: unknown)."""
+    if have is not None and need > have:
+        _refuse(f"{what}: reading it", need, have)
 
 
 def check_solve(path, n_vertices):

@@ -24,9 +24,10 @@ from .linear_response import LinearResponse
 from .local_step import METHODS
 from .operators import cell_graph
 from .rest_edges import RestEdges
-from .settings import DEFAULTS, HANDLE_ROTORS
+from .settings import Settings, with_keywords
 from .starts import STARTS, WARM_STARTS
 from .step import LocalGlobalStep
+from .stop import StopReason
 
 # the ``accel`` setting names a driver
 ACCEL_DRIVERS = {"anderson": "anderson", "none": "plain"}
@@ -41,8 +42,13 @@ class DeformResult:
     positions : (n, 3) float array
     rotors : (n, 4) float array, unit quaternions (w, x, y, z) of the vertex cells
     log : list of dict, one per iteration (0 is the start), keys ``solve_log.LOG_FIELDS``
-    converged : bool, the stopping test passed at full resolution (see ``solve``'s ``tol``)
+    stop_reason : StopReason, why the solve stopped (see :mod:`srarap_cli.solver.stop`)
     iterations : int, local/global iterations run at full resolution
+    stop_detail : str, for a solve stopped unconverged: which stopping test still failed,
+        with its numbers
+    converged : bool (property), the stopping test passed at full resolution
+    complete : bool (property), the solve ended as asked: converged, or ``tol`` 0 ran the
+        iterations asked; for the multiresolution transfer, its coarse solve did
     coarse_iterations : int, iterations on coarse meshes (multiresolution; 0 here)
     coarse_log : bool (class attribute), the log follows another mesh than the result
     approximate : bool (property), the result is the paper's transfer of a coarse solve, not
@@ -53,9 +59,10 @@ class DeformResult:
     coarse_iterations = 0
     positions: np.ndarray
     rotors: np.ndarray
-    log: list[dict] = field(default_factory=list)
-    converged: bool = False
-    iterations: int = 0
+    log: list[dict]
+    stop_reason: StopReason
+    iterations: int
+    stop_detail: str = ""
     #: (f, 3) triangles of the mesh, when the result came from ``srarap_cli.deform`` on a mesh
     faces: np.ndarray | None = None
     #: what the input or the solve found worth a warning (mesh problems, weights)
@@ -84,6 +91,14 @@ class DeformResult:
     @property
     def approximate(self) -> bool:
         return False
+
+    @property
+    def converged(self) -> bool:
+        return self.stop_reason is StopReason.CONVERGED
+
+    @property
+    def complete(self) -> bool:
+        return self.stop_reason.complete
 
     def energies(self) -> dict[str, float]:
         """``membrane``, ``bending`` and ``total`` energy of the returned shape."""
@@ -114,6 +129,10 @@ class Deformer:
     V : (n, 3) float array, rest positions
     F : (f, 3) int array, triangles
     constrained : (k,) int array, ids of vertices whose positions are prescribed
+    settings : Settings, optional, every solver setting at once (default: the defaults);
+        the solve settings in it are what :meth:`solve` uses unless told otherwise
+    **options : setup and solve settings by name, over ``settings`` (as below; see
+        :mod:`srarap_cli.solver.settings`)
     alpha : float > 0, bending weight (energy uses ``alpha * area``)
     feedback : float >= 0, pull of each rotor toward its previous value (paper's eps)
     weights : {"cotan-clamped", "cotan", "uniform"}
@@ -140,11 +159,11 @@ class Deformer:
         rotation-aware start fits one rotation per group); default: the connected patches
         the constrained vertices form
     prepare : bool, factor and build the local step now (False: on first use, for a
-        multiresolution solver that may only need the fine mesh's energy); the other
-        defaults are those of :mod:`srarap_cli.solver.settings`
+        multiresolution solver that may only need the fine mesh's energy)
 
     Attributes
     ----------
+    settings : Settings, the resolved settings the solver was built with
     fixed : (j,) int array, every vertex whose position is held: constrained and auto_fixed
     constrained_slots : (k,) int array, where each constrained vertex sits in ``fixed``
     diagonal : float, the rest mesh's bounding-box diagonal (scale of the stopping test)
@@ -165,28 +184,20 @@ class Deformer:
 
     @single_threaded
     def __init__(self, V: ArrayLike, F: ArrayLike, constrained: ArrayLike, *,
-                 alpha: float = DEFAULTS["alpha"], feedback: float = DEFAULTS["feedback"],
-                 weights: str = DEFAULTS["weights"], area: float | None = None,
-                 method: str = DEFAULTS["method"], sweeps: int = DEFAULTS["sweeps"],
-                 handle_rotors: str = DEFAULTS["handle_rotors"],
-                 labels: ArrayLike | None = None, prepare: bool = True) -> None:
-        if method not in METHODS:
-            raise ValueError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
-        if not alpha > 0:
-            raise ValueError("alpha must be > 0")
-        if not feedback >= 0:
-            raise ValueError("feedback must be >= 0")
-        if handle_rotors not in HANDLE_ROTORS:
-            raise ValueError(f"handle_rotors must be one of {', '.join(HANDLE_ROTORS)}, "
-                             f"not {handle_rotors!r}")
-        self.handle_rotors = handle_rotors
+                 settings: Settings | None = None, area: float | None = None,
+                 labels: ArrayLike | None = None, prepare: bool = True,
+                 **options: Any) -> None:
+        self.settings = with_keywords(settings, options, ("setup", "solve"), "Deformer")
+        s = self.settings
+        alpha, feedback, weights, method = s.alpha, s.feedback, s.weights, s.method
+        self.handle_rotors = s.handle_rotors
         self.V, self.F = api_checks.mesh_arrays(V, F)
         self.weights = weights
         self.graph = cell_graph(self.V, self.F, weights)
         self.alpha = float(alpha)
         self.feedback = float(feedback)
         self.area = self.graph.area if area is None else float(area)
-        self.method, self.sweeps = method, sweeps
+        self.method, self.sweeps = method, s.sweeps
         self.constrained = api_checks.vertex_ids(constrained, len(self.V))
         self._mask = np.zeros(len(self.V), dtype=bool)
         self._mask[self.constrained] = True
@@ -276,44 +287,47 @@ class Deformer:
                                     self.edges.stretch(P) if self.local_step.needs_stretch
                                     else None, R_prev)
 
-    def step_for(self, targets: ArrayLike, tol: float = DEFAULTS["tol"]) -> "LocalGlobalStep":
-        """The :class:`~srarap_cli.solver.step.LocalGlobalStep` of one set of targets."""
-        return LocalGlobalStep(self, targets, tol)
+    def step_for(self, targets: ArrayLike, tol: float | None = None) -> "LocalGlobalStep":
+        """The :class:`~srarap_cli.solver.step.LocalGlobalStep` of one set of targets
+        (``tol``: default the solver's setting)."""
+        return LocalGlobalStep(self, targets, self.settings.tol if tol is None else tol)
 
     @single_threaded
-    def solve(self, targets: ArrayLike, *, max_iter: int = DEFAULTS["max_iter"],
-              tol: float = DEFAULTS["tol"], time_limit: float | None = DEFAULTS["time_limit"],
-              accel: str = DEFAULTS["accel"], start: str = DEFAULTS["start"],
-              initial: tuple[np.ndarray, np.ndarray] | None = None,
+    def solve(self, targets: ArrayLike, *, initial: tuple[np.ndarray, np.ndarray] | None = None,
               callback: Callable[[dict], None] | None = None,
-              driver: Callable | None = None) -> DeformResult:
+              settings: Settings | None = None, start: str | None = None,
+              driver: Callable | str | None = None, **options: Any) -> DeformResult:
         """Deform toward ``targets`` for the constrained vertices.
 
         Parameters
         ----------
         targets : (k, 3) float array, in the order of ``constrained``
-        max_iter : int >= 0, local/global iterations at most
-        tol : float, stop when the relative energy changes ``|E_k - E_{k-1}| / |E_{k-1}|``
-            of the last 3 steps average at most ``tol`` (and the last step moved no vertex
-            by more than ``sqrt(tol)`` of the diagonal of the box around the rest mesh and
-            the targets; see
-            :mod:`srarap_cli.solver.drivers.monitor`)
-        time_limit : float, optional; stop (not converged) once this many seconds have passed
-        accel : {"anderson", "none"}, the driver: accelerated or plain iteration
-        start : str, a name in :data:`srarap_cli.solver.starts.STARTS`: ``harmonic`` or
-            ``laplacian`` without ``initial``; with it, ``warm`` (any other name) or
-            ``extrapolated`` (see :mod:`srarap_cli.solver.starts.warm`)
         initial : (positions (n, 3), rotors (n, 4)), optional warm start: an earlier
             solve's result (``warm``: the start follows the change of the targets to first
             order) or a state that already follows them (``extrapolated``)
         callback : callable(dict), called with each log row
+        settings : Settings, optional; its solve settings replace the solver's own for this
+            solve (its setup settings must be the solver's: ValueError otherwise)
+        start : str, optional, a name in :data:`srarap_cli.solver.starts.STARTS`; overrides
+            the ``start`` setting (``harmonic`` or ``laplacian``) with any registered start:
+            with ``initial``, ``warm`` (any name but ``extrapolated``) or ``extrapolated``
+            (see :mod:`srarap_cli.solver.starts.warm`)
         driver : str or callable, optional, a name in :data:`srarap_cli.solver.drivers.DRIVERS`
             or a driver itself; overrides ``accel``
+        **options : solve settings by name, over ``settings``:
+            ``max_iter`` (int >= 0, local/global iterations at most); ``tol`` (stop when the
+            relative energy changes ``|E_k - E_{k-1}| / |E_{k-1}|`` of the last 3 steps
+            average at most ``tol`` and the last step moved no vertex by more than
+            ``sqrt(tol)`` of the diagonal of the box around the rest mesh and the targets;
+            see :mod:`srarap_cli.solver.drivers.monitor`); ``time_limit`` (seconds, stop
+            not converged); ``accel`` (``anderson`` or ``none``, the driver); ``start``
+            (``harmonic`` or ``laplacian``, the first iterate without ``initial``)
 
         Returns
         -------
         DeformResult
         """
+        s = solve_settings(self.settings, settings, options, "solve")
         targets = api_checks.targets(targets, len(self.constrained))
         if initial is not None:
             initial = api_checks.initial(initial, len(self.V))
@@ -321,18 +335,34 @@ class Deformer:
         # the move test's scale spans the targets too: a handle sent a thousand diagonals
         # away moves vertices by more than the rest mesh's size in every converging step
         extent = np.ptp(np.vstack([self.V.min(axis=0), self.V.max(axis=0), targets]), axis=0)
-        monitor = Monitor(max_iter=max_iter, tol=tol, time_limit=time_limit,
+        monitor = Monitor(max_iter=s.max_iter, tol=s.tol, time_limit=s.time_limit,
                           callback=callback, energy_scale=self.energy_scale,
                           scale=float(np.linalg.norm(extent)))
-        step = self.step_for(targets, tol)
+        step = self.step_for(targets, s.tol)
+        start = start or s.start
+        if start not in STARTS:
+            raise ValueError(f"start must be one of {', '.join(STARTS)}, not {start!r}")
         if initial is not None and start not in WARM_STARTS:
             start = "warm"
         first = STARTS[start](step, initial)
         if not callable(driver):
-            driver = DRIVERS[driver or ACCEL_DRIVERS[accel]]
+            driver = DRIVERS[driver or ACCEL_DRIVERS[s.accel]]
         state = driver(step, first, monitor)
-        return DeformResult(state.positions, state.rotors, monitor.log, monitor.converged,
-                            monitor.iterations)
+        return DeformResult(state.positions, state.rotors, monitor.log, monitor.reason,
+                            monitor.iterations, monitor.detail)
+
+
+def solve_settings(own: Settings, given: Settings | None, options: dict[str, Any],
+                   where: str) -> Settings:
+    """The settings of one solve of a solver built with ``own``: ``given`` (a caller's
+    Settings; its setup settings must equal ``own``'s) or ``own``, with the solve keywords
+    ``options`` over them."""
+    if given is not None:
+        differ = own.fixed_at_setup(given)
+        if differ:
+            raise ValueError(f"{where}(): settings differ from the solver's in "
+                             f"{', '.join(differ)}, fixed when it was built")
+    return with_keywords(given or own, options, ("solve",), where)
 
 
 def unanchored(graph: Any, constrained: np.ndarray) -> tuple[np.ndarray, list[str]]:

@@ -6,44 +6,49 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .deformer import Deformer, DeformResult
+from .interface import Solver
 from .multires import MultiresDeformer, coarse_size
-from .settings import DEFAULT_SETTINGS, check_keywords
+from .settings import Settings, with_keywords
 
 
 def make_deformer(V: ArrayLike, F: ArrayLike, constrained: ArrayLike,
-                  labels: ArrayLike | None = None, *, area: float | None = None,
-                  cache: str | None = None, **options: Any) -> Deformer | MultiresDeformer:
-    """The solver for the settings ``options``: a :class:`Deformer`, or a
-    :class:`MultiresDeformer` when ``multires`` asks for one.
+                  labels: ArrayLike | None = None, *, settings: Settings | None = None,
+                  area: float | None = None, cache: str | None = None,
+                  **options: Any) -> Solver:
+    """The solver for ``settings``: a :class:`~srarap_cli.solver.deformer.Deformer`, or a
+    :class:`~srarap_cli.solver.multires.MultiresDeformer` when ``multires`` asks for one.
 
     Parameters
     ----------
     V : (n, 3) float array; F : (f, 3) int array; constrained : (k,) int array
     labels : (k,) int array, optional, handle group of each constrained vertex
+    settings : Settings, optional, every solver setting (default: the defaults); the
+        solver keeps it, and its solve settings are what ``solve`` uses unless told otherwise
     area : float, optional, ``A`` of the energy (default: the mesh's area)
     cache : str, optional, folder for multiresolution coarse meshes
-    **options : setup and build settings (see :mod:`srarap_cli.solver.settings`)
+    **options : any solver setting by name, over ``settings``
+
+    Returns
+    -------
+    Solver (see :mod:`srarap_cli.solver.interface`)
     """
-    check_keywords(options, ("setup", "build"), "make_deformer")
-    settings = DEFAULT_SETTINGS.replace(**options)
-    setup = settings.stage("setup")
-    setting = settings.multires
-    size = coarse_size(setting, np.shape(V)[0])
+    settings = with_keywords(settings, options, ("setup", "solve", "build"), "make_deformer")
+    n = np.shape(V)[0]
+    size = coarse_size(settings.multires, n)
     if size is None:
-        deformer = Deformer(V, F, constrained, area=area, labels=labels, **setup)
-        if setting not in (None, "auto", "off"):
-            deformer.warnings.append(f"multires {setting} is not below the mesh's "
-                                     f"{np.shape(V)[0]} vertices: solved directly")
+        deformer = Deformer(V, F, constrained, settings=settings, area=area, labels=labels)
+        if settings.multires not in ("auto", "off"):
+            deformer.warnings.append(f"multires {settings.multires} is not below the mesh's "
+                                     f"{n} vertices: solved directly")
         return deformer
-    return MultiresDeformer.or_direct(V, F, constrained, labels, size=size, cache=cache, area=area,
-                            mode=settings.multires_mode,
-                            **setup)
+    return MultiresDeformer.or_direct(V, F, constrained, labels, settings=settings, size=size,
+                                      cache=cache, area=area)
 
 
 def deform(V: ArrayLike, F: ArrayLike, constrained: ArrayLike, targets: ArrayLike, *,
            initial: tuple[np.ndarray, np.ndarray] | None = None,
            callback: Callable[[dict], None] | None = None, cache: str | None = None,
-           **settings: Any) -> DeformResult:
+           settings: Settings | None = None, **options: Any) -> DeformResult:
     """One-shot deformation: build the solver and solve once.
 
     Parameters
@@ -55,8 +60,9 @@ def deform(V: ArrayLike, F: ArrayLike, constrained: ArrayLike, targets: ArrayLik
     initial : (positions, rotors), optional warm start
     callback : callable(dict), optional, receives each log row
     cache : str, optional, folder for multiresolution coarse meshes
-    **settings : any solver setting of :mod:`srarap_cli.solver.settings` (``alpha``, ``tol``,
-        ``time_limit``, ``multires``, ...); the defaults are the CLI's
+    settings : Settings, optional, every solver setting (default: the CLI's defaults)
+    **options : any solver setting of :mod:`srarap_cli.solver.settings` (``alpha``, ``tol``,
+        ``time_limit``, ``multires``, ...), over ``settings``
 
     Returns
     -------
@@ -67,10 +73,9 @@ def deform(V: ArrayLike, F: ArrayLike, constrained: ArrayLike, targets: ArrayLik
     >>> import numpy as np
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
     >>> r = deform(V, [[0, 1, 2], [1, 3, 2]], [0, 1, 2, 3], V + 1.0, time_limit=5)
-    >>> r.converged
-    True
+    >>> r.converged, r.stop_reason.value
+    (True, 'converged')
     """
-    check_keywords(settings, ("setup", "build", "solve"), "deform")
-    resolved = DEFAULT_SETTINGS.replace(**settings)
-    deformer = make_deformer(V, F, constrained, cache=cache, **resolved.stage("setup", "build"))
-    return deformer.solve(targets, initial=initial, callback=callback, **resolved.stage("solve"))
+    resolved = with_keywords(settings, options, ("setup", "solve", "build"), "deform")
+    solver = make_deformer(V, F, constrained, settings=resolved, cache=cache)
+    return solver.solve(targets, initial=initial, callback=callback)

@@ -1,14 +1,17 @@
 """Every solver setting, defined once: name, type, default, allowed values, help.
 
 The handle file's ``solver`` section, a batch manifest's ``settings``, the command line's options
-(built from it in ``cli.options``) and the Python API's defaults are all derived from
-:data:`SETTINGS`. Adding a setting means one entry here plus the code that uses it.
+(built from it in ``cli.options``) and the Python API's keywords are all derived from
+:data:`SETTINGS`, and all resolve through :func:`resolve` into one frozen :class:`Settings`
+that the solver reads. Adding a setting means one entry here, one field of ``Settings`` and the
+code that uses it.
 
-``stage`` says who takes the setting: ``setup`` goes to the solver's constructor (once per mesh
-and constraint set), ``solve`` to each ``solve`` call, ``build`` chooses the solver itself.
+``stage`` says when the setting can change: ``setup`` is fixed when a solver is built (once per
+mesh and constraint set), ``solve`` may change with each ``solve`` call, ``build`` chooses the
+solver itself (direct or multiresolution).
 """
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -115,11 +118,12 @@ SETTINGS = (
             "First iterate: the handles' rotations spread harmonically (harmonic) or identity "
             "rotors (laplacian editing).", "solve", choices=("harmonic", "laplacian")),
     Setting("multires", "size", "auto",
-            "Solve on a simplified mesh of N vertices (or P% of them) and carry the result to "
+            "Solve on a simplified mesh of N vertices (or P% of them, or a fraction like 0.02) "
+            "and carry the result to "
             f"the full mesh; auto = off below {AUTO_THRESHOLD} vertices, else {AUTO_SIZE} or "
             f"1/{AUTO_RATIO} of them, whichever is more (coarse meshes of {AUTO_THRESHOLD} or "
             "more vertices are solved through a coarser one again).",
-            "build", metavar="N|P%|off|auto"),
+            "build", metavar="N|P%|F|off|auto"),
     Setting("multires_mode", "choice", "refine",
             "With multires: refine = the transferred result starts full-resolution iterations "
             "run to tol; transfer = stop after the transfer (the paper's approximation).",
@@ -133,18 +137,21 @@ NAMES = tuple(BY_NAME)
 @dataclass(frozen=True)
 class Settings:
     """Every solver setting, resolved and validated once (see :func:`resolve`), then carried
-    unchanged from the command line or the API to the solver.
+    whole from the command line, a handle file, a manifest or the Python API to the solver,
+    which reads its fields (no keyword dicts in between).
 
     The fields are the names of :data:`SETTINGS` (checked when this module loads); their
-    defaults, bounds and help live in that one table.
+    defaults, bounds and help live in that one table. Construction validates every field;
+    parsing is idempotent (a parsed value parses to itself), so a ``Settings`` rebuilt from
+    its own values, or resolved again over another layer, is unchanged.
 
     Examples
     --------
-    >>> s = resolve({"tol": 1e-8}, {"max_iter": 50, "alpha": None})
-    >>> s.tol, s.max_iter, s.alpha
-    (1e-08, 50, 0.14)
-    >>> sorted(s.stage("solve"))
-    ['accel', 'max_iter', 'start', 'time_limit', 'tol']
+    >>> s = resolve({"tol": 1e-8}, {"max_iter": 50, "alpha": None}, {"multires": "2%"})
+    >>> s.tol, s.max_iter, s.alpha, s.multires
+    (1e-08, 50, 0.14, 0.02)
+    >>> resolve(s.as_dict()) == s
+    True
     """
 
     alpha: float
@@ -161,37 +168,68 @@ class Settings:
     multires: int | float | str
     multires_mode: str
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for name in NAMES:
             value = getattr(self, name)
             if value is not None or BY_NAME[name].default is not None:
-                object.__setattr__(self, name, BY_NAME[name].parse(value, _bad_setting))
+                object.__setattr__(self, name, BY_NAME[name].parse(value, ValueError))
 
-    def stage(self, *stages: str) -> dict:
-        """The settings taken at ``stages`` (``setup``, ``solve``, ``build``) as keywords, less
-        the per-method settings of other local steps."""
-        return {s.name: getattr(self, s.name) for s in SETTINGS
-                if s.stage in stages and s.method in (None, self.method)}
-
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """Every setting by name (JSON-serializable: fingerprints hash it)."""
         return {name: getattr(self, name) for name in NAMES}
 
     def replace(self, **changes: Any) -> "Settings":
         """A copy with ``changes`` (validated; None keeps the current value)."""
-        check_keywords(changes, ("setup", "solve", "build"), "Settings.replace")
-        return Settings(**{**self.as_dict(),
-                           **{k: v for k, v in changes.items() if v is not None}})
+        return with_keywords(self, changes, STAGES, "Settings.replace")
+
+    def fixed_at_setup(self, other: "Settings") -> list[str]:
+        """The setup and build settings in which ``other`` differs from this one: what a
+        solver built with this one cannot change per solve."""
+        return [s.name for s in SETTINGS if s.stage != "solve"
+                and getattr(self, s.name) != getattr(other, s.name)]
 
 
-def _bad_setting(message):
-    return ValueError(message)
+STAGES = ("setup", "solve", "build")
 
 
-def resolve(file_settings: dict, overrides: dict) -> Settings:
-    """Defaults, then a handle file's ``solver`` section, then explicit options (not None)."""
-    return Settings(**{**DEFAULTS, **file_settings,
-                       **{k: v for k, v in overrides.items() if v is not None}})
+def resolve(*layers: "Mapping[str, Any] | Settings") -> Settings:
+    """The one way settings are made: the defaults, then each layer in turn (later layers
+    win; a None value means "not given"). A layer is a mapping of setting names (a handle
+    file's ``solver`` section, a manifest's ``settings``, the command line's options, the
+    Python API's keywords, each checked by its reader) or a :class:`Settings`.
+
+    Raises ValueError naming the setting for a bad value, KeyError for an unknown name.
+    """
+    merged = dict(DEFAULTS)
+    for layer in layers:
+        items = layer.as_dict() if isinstance(layer, Settings) else layer
+        for name, value in items.items():
+            if name not in BY_NAME:
+                raise KeyError(f"unknown setting {name!r}")
+            if value is not None:
+                merged[name] = value
+    return Settings(**merged)
+
+
+def keywords(options: Mapping[str, Any], stages: tuple[str, ...],
+             where: str) -> dict[str, Any]:
+    """A Python caller's setting keywords, parsed: TypeError naming a keyword that is not a
+    setting taken at ``stages``, ValueError naming a bad value; None values are dropped
+    ("not given")."""
+    for name in options:
+        if name not in BY_NAME or BY_NAME[name].stage not in stages:
+            allowed = sorted(s.name for s in SETTINGS if s.stage in stages)
+            raise TypeError(f"{where}() got an unexpected keyword {name!r} "
+                            f"(solver settings: {', '.join(allowed)})")
+    return {name: BY_NAME[name].parse(value, ValueError) for name, value in options.items()
+            if value is not None}
+
+
+def with_keywords(base: Settings | None, options: Mapping[str, Any],
+                  stages: tuple[str, ...], where: str) -> Settings:
+    """``base`` (default: the defaults) with a Python caller's keywords over it (see
+    :func:`keywords`), as the API's functions and classes take them."""
+    return resolve(base or DEFAULT_SETTINGS, keywords(options, stages, where))
 
 
 DEFAULT_SETTINGS = Settings(**DEFAULTS)
@@ -199,34 +237,16 @@ DEFAULT_SETTINGS = Settings(**DEFAULTS)
 
 def parse_mapping(spec: Any, name: str, error: Callable[[str], Exception]) -> dict[str, Any]:
     """Validated settings from the mapping ``name`` (a handle file's ``solver``, a manifest's
-    ``settings``); ``error(message)`` makes the exception raised for a bad key or value."""
+    ``settings``); ``error(message)`` makes the exception raised for a bad key or value, so
+    the message names the file and section. The values are parsed (and parse to themselves
+    again when :func:`resolve` builds the Settings)."""
     if not isinstance(spec, dict):
         raise error(f"{name} must be a mapping of {', '.join(NAMES)}")
     unknown = sorted(set(map(str, spec)) - set(NAMES))
     if unknown:
         raise error(f"unknown key {unknown[0]!r} in {name} "
                     f"(allowed: {', '.join(sorted(NAMES))})")
-    return {name: BY_NAME[name].parse(value, error) for name, value in spec.items()}
-
-
-def check_keywords(options: dict[str, Any], allowed_stages: tuple[str, ...], where: str) -> None:
-    """Raise TypeError naming the first keyword of ``options`` that is not a setting taken
-    at one of ``allowed_stages``."""
-    for name in options:
-        if name not in BY_NAME or BY_NAME[name].stage not in allowed_stages:
-            allowed = sorted(s.name for s in SETTINGS if s.stage in allowed_stages)
-            raise TypeError(f"{where}() got an unexpected keyword {name!r} "
-                            f"(solver settings: {', '.join(allowed)})")
-
-
-def complete(result: Any, opts: "Settings") -> bool:
-    """Whether a solve ended as asked: converged; or ``tol`` 0 (no stopping test: run exactly
-    ``max_iter`` iterations) with every iteration run; or the approximate mode (transfer),
-    whose coarse solve converged (the full-resolution shape is never iterated there)."""
-    if result.approximate:
-        return bool(result.coarse_converged) or (
-            opts.tol == 0 and result.coarse_iterations >= opts.max_iter)
-    return bool(result.converged) or (opts.tol == 0 and result.iterations >= opts.max_iter)
+    return {key: BY_NAME[key].parse(value, error) for key, value in spec.items()}
 
 
 if tuple(Settings.__dataclass_fields__) != NAMES:

@@ -24,7 +24,7 @@ from ..solver.quaternion import align_hemisphere, multiply, normalize
 from .pipeline import command_solver, problem, scatter
 
 FRAME_FIELDS = ("frame", "iterations", "membrane", "bending", "total", "converged",
-                "min_rotor_dot", "seconds")
+                "min_rotor_dot", "seconds", "stop")
 
 
 @dataclass
@@ -77,13 +77,14 @@ class Animator:
         self.problem = problem(mesh, constraints, name)
         #: warnings: what the mesh checks and the solver found (e.g. mesh problems)
         self.deformer, self.warnings = command_solver(mesh, self.problem, opts, cache)
-        self.solve_options = {"accel": opts.accel, "start": opts.start}
         self.last_result = None
 
-    def run(self, frames, *, max_iter, tol, stop_unconverged=False, state=None,
+    def run(self, frames, *, max_iter=None, stop_unconverged=False, state=None,
             on_frame=None, fingerprint=""):
-        """Solve frames ``state.frame + 1`` (or 0) to ``frames - 1``, each to ``tol`` or
-        ``max_iter`` iterations.
+        """Solve frames ``state.frame + 1`` (or 0) to ``frames - 1``, each with the solve
+        settings the Animator was built with (``tol``, ``max_iter``, ``time_limit``,
+        ``accel``, ``start``: the limits hold per frame); ``max_iter`` replaces the setting
+        (a fixed budget per frame).
 
         ``on_frame(frame, positions, state)`` receives the full-mesh positions (n, 3) and the
         FrameState after each frame. With ``stop_unconverged`` the run stops at the first
@@ -101,11 +102,11 @@ class Animator:
             start = time.perf_counter()
             frame_targets = self.constraints.targets_at(float(f))
             targets = self.problem.targets_for(frame_targets)
-            options = dict(self.solve_options)
+            options = {}
             if P is not None:
                 # the carried frames follow the targets to first order already
                 options.update(start="extrapolated", initial=_carried(P, R, before))
-            result = self.deformer.solve(targets, max_iter=max_iter, tol=tol, **options)
+            result = self.deformer.solve(targets, max_iter=max_iter, **options)
             self.last_result = result
             # the solver's own rotors against the previous frame's: negative means a sign flip
             dot = 1.0 if R is None else float(np.einsum("ij,ij->i", result.rotors, R).min())
@@ -113,7 +114,8 @@ class Animator:
             row = {"frame": f, "iterations": result.iterations,
                    "membrane": energy["membrane"], "bending": energy["bending"],
                    "total": energy["total"], "converged": result.converged,
-                   "min_rotor_dot": dot, "seconds": time.perf_counter() - start}
+                   "min_rotor_dot": dot, "seconds": time.perf_counter() - start,
+                   "stop": result.stop_reason.value}
             if stop_unconverged and not result.converged:
                 self.stopped_at, self.stopped_row = f, row
                 break

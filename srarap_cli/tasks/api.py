@@ -10,14 +10,14 @@ from ..io.mesh.mesh import Mesh
 from ..solver.api_checks import mesh_like
 from ..solver.deformer import DeformResult
 from ..solver.oneshot import deform as deform_arrays
-from ..solver.settings import check_keywords
+from ..solver.settings import Settings, keywords, resolve
 from .pipeline import deform_mesh
 
 
 def deform(mesh: Any, handles: Any, *arrays: Any,
            callback: Callable[[dict], None] | None = None, cache: str | None = None,
            initial: tuple[np.ndarray, np.ndarray] | None = None,
-           **settings: Any) -> DeformResult:
+           settings: Settings | None = None, **options: Any) -> DeformResult:
     """Deform a mesh by its handles, in one call.
 
     Parameters
@@ -29,8 +29,10 @@ def deform(mesh: Any, handles: Any, *arrays: Any,
         or an ``(ids, targets)`` pair: (k,) vertex ids and their (k, 3) target positions
     callback : callable(dict), optional, receives each log row
     cache : str, optional, folder for multiresolution coarse meshes
-    **settings : solver settings (``alpha``, ``tol``, ``max_iter``, ``multires``, ...); a
-        handle file's ``solver`` section applies under them
+    settings : Settings, optional, the base (default: the defaults) that a handle file's
+        ``solver`` section and the keywords apply over
+    **options : solver settings by name (``alpha``, ``tol``, ``max_iter``, ``multires``,
+        ...), over the handle file's
 
     Returns
     -------
@@ -51,16 +53,16 @@ def deform(mesh: Any, handles: Any, *arrays: Any,
     """
     if len(arrays) == 2:
         return deform_arrays(mesh, handles, *arrays, initial=initial, callback=callback,
-                             cache=cache, **settings)
+                             cache=cache, settings=settings, **options)
     if arrays:
         raise TypeError("deform() takes (mesh, handles) or (V, F, constrained, targets), "
                         f"got {2 + len(arrays)} positional arguments")
     if initial is not None:
         raise TypeError("deform(mesh, handles) starts cold; for a warm start use "
                         "deform(V, F, constrained, targets, initial=...) or a Deformer")
-    check_keywords(settings, ("setup", "build", "solve"), "deform")
+    given = keywords(options, ("setup", "solve", "build"), "deform")
     source = mesh if isinstance(mesh, Mesh) else Mesh.from_arrays(*mesh_like(mesh))
     constraints = as_constraints(handles, source.vertices)
-    _, result, notes = deform_mesh(source, constraints, callback=callback, cache=cache,
-                                   **settings)
+    opts = resolve(settings or {}, constraints.solver, given)
+    _, result, notes = deform_mesh(source, constraints, opts, callback=callback, cache=cache)
     return replace(result, faces=source.triangles()[0], warnings=list(notes))

@@ -28,16 +28,21 @@ from importlib import metadata
 from ..io.documents import load_document
 from ..io.handles import load_handles, referenced_files
 from ..io.input_files import read_input_bytes
-from ..io.mesh import WRITE_FORMATS, format_mesh, read_mesh
+from ..io.mesh import format_mesh, read_mesh
+from ..io.mesh.formats import extensions
 from ..runtime.commit import commit_files
-from ..runtime.errors import InputError, excerpt
+from ..runtime.errors import InputError, NumericalError, excerpt
 from ..runtime.paths import refuse_overwriting_inputs
-from ..solver.settings import complete, parse_mapping, resolve
+from ..solver.settings import parse_mapping, resolve
+from ..solver.stop import StopReason
 from .compare import compare_meshes
 from .pipeline import deform_mesh
 
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
-SUMMARY_FIELDS = ("job", "status", "iterations", "energy", "seconds", "compare_max", "message")
+#: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason` (empty for a job that
+#: never reached the solver)
+SUMMARY_FIELDS = ("job", "status", "stop", "iterations", "energy", "seconds", "compare_max",
+                  "message")
 
 
 def load_manifest(path):
@@ -90,9 +95,9 @@ def _output_name(where, value):
     if os.path.isabs(value) or norm == ".." or norm.startswith(".." + os.sep):
         raise InputError(f"{where}: output {excerpt(value)!r} must stay inside the output "
                          "folder (-o): no absolute path, no '..'")
-    if os.path.splitext(norm)[1].lower() not in WRITE_FORMATS:
+    if os.path.splitext(norm)[1].lower() not in extensions():
         raise InputError(f"{where}: output {excerpt(value)!r} needs one of the extensions "
-                         f"{', '.join(WRITE_FORMATS)}")
+                         f"{', '.join(extensions())}")
     return norm
 
 
@@ -136,8 +141,8 @@ def run_job(job, out_dir, keep_unconverged=False):
     A job that does not converge writes its sidecar (the status, so a rerun reports it without
     solving again) but not its mesh, unless ``keep_unconverged``: as ``srarap deform``."""
     start = time.perf_counter()
-    row = {"job": job["name"], "status": "failed", "iterations": None, "energy": None,
-           "seconds": None, "compare_max": None, "message": ""}
+    row = {"job": job["name"], "status": "failed", "stop": "", "iterations": None,
+           "energy": None, "seconds": None, "compare_max": None, "message": ""}
     out = os.path.join(out_dir, job["output"])
     sidecar = out + ".srarap.json"
     try:
@@ -154,14 +159,16 @@ def run_job(job, out_dir, keep_unconverged=False):
             mesh = read_mesh(job["mesh"])
             constraints = load_handles(job["handles"], mesh.vertices)
             opts = resolve(constraints.solver, job["settings"])
-            deformed, result, _ = deform_mesh(mesh, constraints, name=job["mesh"],
-                                              settings=opts)
+            deformed, result, _ = deform_mesh(mesh, constraints, opts, name=job["mesh"])
             data, _ = format_mesh(deformed, os.path.splitext(out)[1].lower())
-            status = "ok" if complete(result, opts) else "not-converged"
-            row.update(status=status, iterations=result.iterations, energy=result.energy)
+            status = "ok" if result.complete else "not-converged"
+            stop = result.stop_reason.value
+            row.update(status=status, stop=stop, iterations=result.iterations,
+                       energy=result.energy)
             os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
             record = json.dumps({"fingerprint": key, "iterations": result.iterations,
-                                 "energy": result.energy, "status": status}).encode()
+                                 "energy": result.energy, "status": status,
+                                 "stop": stop}).encode()
             keep = status == "ok" or keep_unconverged
             commit_files([(out, data)] * keep + [(sidecar, record)])
             if not keep:
@@ -171,6 +178,8 @@ def run_job(job, out_dir, keep_unconverged=False):
     except Exception as exc:  # noqa: BLE001 -- a failing job is reported, never fatal
         row.update(status="failed", message=str(exc).splitlines()[0] if str(exc) else
                    type(exc).__name__)
+        if isinstance(exc, NumericalError):
+            row["stop"] = StopReason.NON_FINITE.value
     row["seconds"] = time.perf_counter() - start
     return row
 
@@ -198,7 +207,7 @@ def _recorded_row(sidecar):
     with open(sidecar) as fh:
         rec = json.load(fh)
     return {"iterations": rec.get("iterations"), "energy": rec.get("energy"),
-            "status": rec["status"]}
+            "status": rec["status"], "stop": rec.get("stop", "")}
 
 
 def run_batch(jobs, out_dir, workers=1, scheduler=None, keep_unconverged=False):

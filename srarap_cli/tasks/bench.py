@@ -31,13 +31,15 @@ class MethodRun:
     summary: dict = field(default_factory=dict)
 
 
-def run_methods(V, F, ids, targets, methods, *, settings, time_budget, max_iter, tol, sweeps):
+def run_methods(V, F, ids, targets, methods, *, settings, time_budget):
     """Run ``methods`` (names from ALL_METHODS, plus ``libigl-arap``) on one problem.
 
     A plain method name runs the plain iteration from Laplacian editing (the paper's
     setting); ``<method>+anderson`` runs the tool's default, Anderson acceleration from the
     harmonic start. ``arap`` and ``libigl-arap`` use unclamped cotangent weights, as libigl
-    does, so the two can be compared; the SR methods use ``settings.weights``.
+    does, so the two can be compared; the SR methods use ``settings.weights``. Every other
+    setting comes from ``settings`` (a :class:`~srarap_cli.solver.settings.Settings`):
+    ``max_iter`` and ``tol`` stop each method, as does ``time_budget`` (seconds).
 
     Returns
     -------
@@ -46,17 +48,17 @@ def run_methods(V, F, ids, targets, methods, *, settings, time_budget, max_iter,
     runs = []
     for name in methods:
         if name == IGL:
-            runs.append(_run_igl(V, F, ids, targets, time_budget, max_iter))
+            runs.append(_run_igl(V, F, ids, targets, time_budget, settings.max_iter))
             continue
         t0 = time.perf_counter()
         method = name.removesuffix(ACCELERATED)
-        weights = "cotan" if method == "arap" else settings.weights
-        d = Deformer(V, F, ids, alpha=settings.alpha, feedback=settings.feedback,
-                     weights=weights, method=method, sweeps=sweeps)
-        pre = time.perf_counter() - t0
         variant = ({"accel": "anderson", "start": "harmonic"} if name.endswith(ACCELERATED)
                    else {"accel": "none", "start": "laplacian"})
-        r = d.solve(targets, max_iter=max_iter, tol=tol, time_limit=time_budget, **variant)
+        chosen = settings.replace(method=method, time_limit=time_budget, **variant,
+                                  **({"weights": "cotan"} if method == "arap" else {}))
+        d = Deformer(V, F, ids, settings=chosen)
+        pre = time.perf_counter() - t0
+        r = d.solve(targets)
         runs.append(MethodRun(name, r.log, r.positions, pre))
     _summarize(runs, ids, targets)
     return runs
@@ -91,7 +93,8 @@ def _igl_row(scorer, P, k, seconds, P_prev):
     e = scorer.energy(P, R)["membrane"]
     move = 0.0 if P_prev is None else float(np.linalg.norm(P - P_prev, axis=1).max())
     return {"iteration": k, "membrane": e, "bending": 0.0, "total": e, "rel_change": float("nan"),
-            "max_move": move, "seconds": seconds, "step": "start" if P_prev is None else "plain"}
+            "max_move": move, "seconds": seconds, "step": "start" if P_prev is None else "plain",
+            "stop": ""}
 
 
 def _summarize(runs, ids, targets):

@@ -10,12 +10,13 @@ from ..io.mesh import Mesh
 from ..runtime.allocator import keep_freed_memory
 from ..runtime.errors import InputError
 from ..solver.deformer import DeformResult
+from ..solver.interface import Solver
 from ..solver.mesh_checks import geometry_problem, mesh_warnings, solvable_faces
 from ..solver.oneshot import make_deformer
 from ..solver.operators import mesh_area
 from ..solver.quaternion import IDENTITY
 from ..solver.region import restrict
-from ..solver.settings import Settings, resolve
+from ..solver.settings import STAGES, Settings, resolve, with_keywords
 
 
 @dataclass
@@ -83,21 +84,15 @@ def _labels(constraints, full_ids):
     return np.unique(labels, return_inverse=True)[1].ravel()
 
 
-def build_deformer(p: Problem, opts: Settings, cache: str | None = None) -> Any:
-    """The solver of a :class:`Problem` with resolved settings ``opts`` (see
-    :func:`~srarap_cli.solver.oneshot.make_deformer`; ``cache``: folder for coarse meshes)."""
-    return make_deformer(p.V, p.F, p.ids, p.labels, area=p.area, cache=cache,
-                         **opts.stage("setup", "build"))
-
-
 def command_solver(mesh: Mesh, p: Problem, opts: Settings,
-                   cache: str | None = None) -> tuple[Any, list[str]]:
+                   cache: str | None = None) -> tuple[Solver, list[str]]:
     """The solver of ``p`` for a command (deform, animate) and the warnings of the mesh and
     of the solver. The mesh checks run before the solver is built, so their temporaries
     (edge tables of the whole mesh) do not add to the memory it holds (2M-vertex bar: peak
     11.4 -> 10.6 GiB); once it is built, the process keeps freed memory for reuse."""
     notes = mesh_warnings(mesh.vertices, mesh.triangles()[0])
-    deformer = build_deformer(p, opts, cache)
+    deformer = make_deformer(p.V, p.F, p.ids, p.labels, settings=opts, area=p.area,
+                             cache=cache)
     keep_freed_memory()  # after the setup, whose large arrays are allocated once
     return deformer, notes + list(deformer.warnings)
 
@@ -113,22 +108,22 @@ def scatter(mesh: Mesh, p: Problem, positions: np.ndarray, constraints: Constrai
     return out
 
 
-def deform_mesh(mesh: Mesh, constraints: Constraints,
+def deform_mesh(mesh: Mesh, constraints: Constraints, settings: Settings | None = None,
                 callback: Callable[[dict], None] | None = None, cache: str | None = None,
-                name: str = "mesh", settings: Settings | None = None,
-                **overrides: Any) -> tuple[Mesh, DeformResult, list[str]]:
+                name: str = "mesh", **options: Any) -> tuple[Mesh, DeformResult, list[str]]:
     """Deform a :class:`~srarap_cli.io.mesh.Mesh` by its :class:`~srarap_cli.io.handles.Constraints`.
 
     Parameters
     ----------
     mesh : Mesh
     constraints : Constraints
+    settings : Settings, optional, resolved (:func:`srarap_cli.solver.settings.resolve`:
+        the defaults, the handle file's ``solver`` section, then the command line's); default
+        the handle file's settings over the defaults
     callback : callable(dict), optional, receives each log row
     cache : str, optional, folder for multiresolution coarse meshes
     name : str, the mesh's file, for error messages
-    settings : Settings, optional, already resolved (the command line's); then no overrides
-    **overrides : any solver setting (see :mod:`srarap_cli.solver.settings`); None means the
-        handle file's value or the default
+    **options : solver settings by name, over ``settings``
 
     Returns
     -------
@@ -136,12 +131,11 @@ def deform_mesh(mesh: Mesh, constraints: Constraints,
     result : DeformResult (or MultiresResult), positions/rotors of the whole mesh
     warnings : list of str
     """
-    if settings is not None and overrides:
-        raise TypeError("deform_mesh() takes settings or keyword overrides, not both")
-    opts = settings if settings is not None else resolve(constraints.solver, overrides)
+    settings = with_keywords(settings or resolve(constraints.solver), options, STAGES,
+                             "deform_mesh")
     p = problem(mesh, constraints, name)
-    deformer, notes = command_solver(mesh, p, opts, cache)
-    sub_result = deformer.solve(p.targets, callback=callback, **opts.stage("solve"))
+    deformer, notes = command_solver(mesh, p, settings, cache)
+    sub_result = deformer.solve(p.targets, callback=callback)
     positions = scatter(mesh, p, sub_result.positions, constraints)
     rotors = np.tile(IDENTITY, (len(positions), 1))
     rotors[p.vertices] = sub_result.rotors

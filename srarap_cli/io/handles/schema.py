@@ -75,7 +75,9 @@ def _setting(s):
     kind = {"float": {"type": "number"}, "int": {"type": "integer"},
             "choice": {"enum": list(s.choices)},
             "size": {"oneOf": [{"type": "integer", "minimum": 4},
-                               {"type": "string", "pattern": r"^\s*(off|auto|\d+(\.\d*)?\s*%)\s*$"}]}
+                               {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
+                               {"type": "string",
+                                "pattern": r"^\s*(off|auto|\d+(\.\d*)?\s*%|0*\.\d+)\s*$"}]}
             }[s.kind]
     if s.minimum is not None and s.kind in ("float", "int"):
         kind["exclusiveMinimum" if s.strict else "minimum"] = s.minimum

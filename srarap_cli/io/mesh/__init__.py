@@ -13,47 +13,35 @@ import numpy as np
 from ...runtime.commit import atomic_write
 from ...runtime.errors import InputError, OutputError
 from ...runtime.limits import MAX_COORDINATE, check_read
+from .formats import FORMATS, MeshFormat, by_extension, extensions, register_format
 from .mesh import Mesh
-from .normals import recompute_normals
-from .obj import format_obj, obj_frames, read_obj
-from .off import format_off, read_off
-from .ply import format_ply, per_vertex
-from .ply_read import read_ply
-from .stl import format_stl, read_stl
 
-READ_FORMATS = (".obj", ".off", ".ply", ".stl")
-WRITE_FORMATS = (".obj", ".off", ".ply", ".stl")
-
-__all__ = ["READ_FORMATS", "WRITE_FORMATS", "Mesh", "atomic_write", "read_mesh", "write_mesh"]
+__all__ = ["FORMATS", "Mesh", "MeshFormat", "atomic_write", "format_mesh", "read_mesh",
+           "register_format", "write_mesh"]
 
 
-def _suffix(path):
-    return os.path.splitext(str(path))[1].lower()
+def _listed():
+    return ", ".join(extensions())
 
 
-def read_mesh(path: str | os.PathLike) -> Mesh:
-    """Read OBJ, OFF, PLY or STL into a :class:`Mesh`.
+def read_mesh(path: str | os.PathLike, fmt: MeshFormat | None = None) -> Mesh:
+    """Read any registered format (OBJ, OFF, PLY, STL, ...; see :mod:`.formats`) into a
+    :class:`Mesh`, by the file's extension or as ``fmt``.
 
     Raises
     ------
     InputError : the file is missing, unreadable, of another format or invalid.
     """
-    suffix = _suffix(path)
-    if suffix not in READ_FORMATS:
+    fmt = fmt or by_extension(str(path))
+    if fmt is None:
+        suffix = os.path.splitext(str(path))[1].lower()
         raise InputError(f"{path}: unsupported mesh format {suffix or '(none)'!r}; "
-                         f"use one of {', '.join(READ_FORMATS)}")
+                         f"use one of {_listed()}")
     if os.path.isdir(path):
         raise InputError(f"{path}: is a folder, not a mesh file")
-    check_read(path)
+    check_read(path, fmt.read_factor)
     try:
-        if suffix == ".obj":
-            mesh = read_obj(path)
-        elif suffix == ".off":
-            mesh = read_off(path)
-        elif suffix == ".ply":
-            mesh = read_ply(path)
-        else:
-            mesh = read_stl(path)
+        mesh = fmt.read(str(path))
     except InputError:
         raise
     except (OSError, UnicodeDecodeError) as exc:
@@ -86,39 +74,21 @@ def frame_formatter(mesh: Mesh, suffix: str) -> Callable[[np.ndarray], bytes]:
     format of ``suffix``, as :func:`format_mesh` writes it; an OBJ's faces, statements and
     texture coordinates are formatted once for every frame (a 50k-vertex tube with uvs:
     about 0.09 s of each frame's 0.14 s of formatting)."""
-    if suffix == ".obj":
-        return obj_frames(mesh)
-    return lambda positions: format_mesh(mesh.with_vertices(positions), suffix)[0]
+    return _writable(suffix).frame_writer(mesh)
 
 
 def format_mesh(mesh: Mesh, suffix: str, ascii: bool = False) -> tuple[bytes, list[str]]:
-    """File content for ``mesh`` in the format of ``suffix`` (PLY in ASCII with ``ascii``),
-    with warnings for lost data."""
-    lost: list[str] = []
-    if suffix == ".obj":
-        return format_obj(mesh).encode("utf-8"), lost
-    if suffix == ".stl":
-        if (mesh.face_sizes != 3).any() or mesh.uv is not None or mesh.normals is not None:
-            lost.append("STL keeps only triangles in single precision: polygons split, "
-                        "texture coordinates and normals not written, vertices not shared")
-        return format_stl(mesh), lost
-    if mesh.uv is not None and (suffix == ".off" or per_vertex(mesh, mesh.uv, mesh.face_uv) is None):
-        lost.append(f"texture coordinates not written: {suffix[1:].upper()} stores at most one "
-                    "per vertex; write .obj to keep them")
-    if mesh.normals is not None and per_vertex(mesh, mesh.normals, mesh.face_normals) is None:
-        mesh = _vertex_normals(mesh)
-    if suffix == ".off":
-        return format_off(mesh).encode("ascii"), lost
-    return format_ply(mesh, ascii), lost
+    """File content for ``mesh`` in the format of the extension ``suffix`` (``.obj``; a text
+    variant with ``ascii`` where the format has one), with warnings for lost data."""
+    return _writable(suffix).write(mesh, ascii)
 
 
-def _vertex_normals(mesh):
-    """Per-corner normals (OBJ) become per-vertex normals for formats that only have those."""
-    out = Mesh(**{k: getattr(mesh, k) for k in mesh.__dataclass_fields__})
-    out.normals = np.zeros_like(mesh.vertices)
-    out.face_normals = mesh.face_vertices
-    out.normals = recompute_normals(out)
-    return out
+def _writable(suffix):
+    fmt = by_extension("x" + suffix)
+    if fmt is None:
+        raise OutputError(f"cannot write {suffix or 'files without extension'}; "
+                          f"use one of {_listed()}")
+    return fmt
 
 
 def write_mesh(path: str | os.PathLike, mesh: Mesh) -> list[str]:
@@ -126,7 +96,8 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh) -> list[str]:
 
     Parameters
     ----------
-    path : str or PathLike, ``.obj``, ``.off`` or ``.ply``
+    path : str or PathLike, with a registered extension (``.obj``, ``.off``, ``.ply``,
+        ``.stl``, ...)
     mesh : Mesh, or anything :func:`srarap_cli.solver.api_checks.mesh_like` takes (a
         ``(V, F)`` pair, a trimesh or meshio mesh)
 
@@ -142,10 +113,11 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh) -> list[str]:
         from ...solver.api_checks import mesh_like
 
         mesh = Mesh.from_arrays(*mesh_like(mesh))
-    suffix = _suffix(path)
-    if suffix not in WRITE_FORMATS:
+    fmt = by_extension(str(path))
+    if fmt is None:
+        suffix = os.path.splitext(str(path))[1].lower()
         raise OutputError(f"{path}: cannot write {suffix or 'files without extension'}; "
-                          f"use one of {', '.join(WRITE_FORMATS)}")
-    data, lost = format_mesh(mesh, suffix)
+                          f"use one of {_listed()}")
+    data, lost = fmt.write(mesh, False)
     atomic_write(path, data)
     return lost

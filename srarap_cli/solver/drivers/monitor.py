@@ -19,6 +19,7 @@ import time
 import numpy as np
 
 from ...runtime.errors import NumericalError
+from ..stop import StopReason
 
 #: iterates whose mean relative energy change is compared with ``tol``
 WINDOW = 3
@@ -57,7 +58,10 @@ class Monitor:
 
     Attributes
     ----------
-    log : list of dict, one row per recorded iterate (keys ``solve_log.LOG_FIELDS``)
+    log : list of dict, one row per recorded iterate (keys ``solve_log.LOG_FIELDS``); the
+        last row's ``stop`` holds the stop reason, the others' is empty
+    reason : StopReason or None (still running)
+    detail : str, which test kept an unconverged solve from stopping, with its numbers
     converged : bool
     iterations : int, steps recorded after the start
     """
@@ -70,8 +74,13 @@ class Monitor:
         self.energy_floor = FLOOR * energy_scale
         self.exact_energy = max(tol, 0.0) * EXACT * energy_scale
         self.log = []
-        self.converged = False
+        self.reason: StopReason | None = None
+        self.detail = ""
         self.start = time.perf_counter()
+
+    @property
+    def converged(self):
+        return self.reason is StopReason.CONVERGED
 
     @property
     def iterations(self):
@@ -94,17 +103,42 @@ class Monitor:
         row = {"iteration": len(self.log), "membrane": state.membrane,
                "bending": state.bending, "total": total, "rel_change": rel,
                "max_move": move, "seconds": time.perf_counter() - self.start,
-               "step": kind or ("start" if previous is None else "plain")}
+               "step": kind or ("start" if previous is None else "plain"), "stop": ""}
         self.log.append(row)
+        self.reason = self._reason(previous is None, move, row["seconds"])
+        if self.reason is not None:
+            row["stop"] = self.reason.value
         if self.callback is not None:
             self.callback(row)
-        if previous is None:
-            return self.max_iter <= 0
+        return self.reason is not None
+
+    def _reason(self, start, move, seconds):
+        """The stop reason after the latest row, or None to go on."""
+        if not start:
+            changes = recent_changes(self.log)
+            settled = len(changes) == WINDOW and sum(changes) <= WINDOW * self.tol
+            exact = abs(self.log[-1]["total"]) < self.exact_energy
+            if (settled or exact) and move <= self.move_tol:
+                return StopReason.CONVERGED
+        if self.iterations >= self.max_iter:
+            reason = StopReason.ITERATIONS_RUN if self.tol == 0 else StopReason.ITERATION_LIMIT
+        elif not start and self.time_limit is not None and seconds >= self.time_limit:
+            reason = StopReason.TIME_LIMIT
+        else:
+            return None
+        self.detail = self._unsettled()
+        return reason
+
+    def _unsettled(self):
+        """Which stopping test was still failing, with the numbers it compared."""
         changes = recent_changes(self.log)
-        settled = len(changes) == WINDOW and sum(changes) <= WINDOW * self.tol
-        exact = abs(total) < self.exact_energy
-        if (settled or exact) and move <= self.move_tol:
-            self.converged = True
-            return True
-        timed_out = self.time_limit is not None and row["seconds"] >= self.time_limit
-        return timed_out or self.iterations >= self.max_iter
+        if not changes:
+            return "no iteration ran"
+        mean = sum(changes) / len(changes)
+        if mean > self.tol:
+            return (f"relative change {mean:.3g} per step over the last {len(changes)} > "
+                    f"tol {self.tol:g}")
+        if len(changes) < WINDOW:
+            return f"only {len(changes)} of the {WINDOW} steps the energy test averages ran"
+        return (f"relative change {mean:.3g} per step but the last step still moved a vertex "
+                f"by {self.log[-1]['max_move']:.3g}")

@@ -13,13 +13,14 @@ from numpy.typing import ArrayLike
 from ...runtime.errors import NumericalError
 from ...runtime.threads import background, single_threaded
 from .. import api_checks
-from ..deformer import ACCEL_DRIVERS, Deformer, DeformResult
+from ..deformer import ACCEL_DRIVERS, Deformer, DeformResult, solve_settings
 from ..drivers.anderson import anderson_iteration
 from ..group_rotations import connected_groups, group_rotors
 from ..mesh_checks import edge_adjacency
 from ..quaternion import IDENTITY
-from ..settings import DEFAULTS
+from ..settings import Settings, with_keywords
 from ..starts import STARTS
+from ..stop import StopReason
 from .cache import coarse_mesh
 from .correction import CoarseCorrection
 from .dirichlet import DirichletSolver
@@ -31,7 +32,6 @@ STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
                "factor": "fine setup", "coarse_solve": "coarse solve", "transfer": "transfer",
                "fine_solve": "fine solve", "fine_start": "full-resolution start",
                "fine_iterations": "full-resolution iterations"}
-MODES = ("refine", "transfer")
 #: full-resolution iterations of a warm solve before the coarse-grid corrections join
 WARM_UNCORRECTED = 5
 #: a coarse mesh keeping more than this fraction of the vertices gains nothing over a
@@ -54,7 +54,9 @@ class MultiresResult(DeformResult):
         full-resolution setup run side by side, so the stages add up to more than the wall time
     coarse : dict, ``vertices`` (coarse count), ``of`` (full count), ``cache_hit``
     coarse_iterations : int, iterations of the coarse solve (and the coarser ones inside it)
-    coarse_converged : bool, the coarse solve passed its stopping test
+    coarse_stop_reason : StopReason or None, why the coarse solve stopped (None: a warm
+        solve, which has none)
+    coarse_converged : bool (property), the coarse solve passed its stopping test
     start_energy : dict, transfer mode: the full-resolution energies of the rest shape with
         the constrained vertices at their targets (what the approximation is judged against)
     wall : float, wall seconds of the solve (setup excluded)
@@ -65,7 +67,7 @@ class MultiresResult(DeformResult):
     stages: dict = field(default_factory=dict)
     coarse: dict = field(default_factory=dict)
     coarse_iterations: int = 0
-    coarse_converged: bool = False
+    coarse_stop_reason: StopReason | None = None
     start_energy: dict = field(default_factory=dict)
     wall: float = 0.0
 
@@ -75,6 +77,18 @@ class MultiresResult(DeformResult):
     @property
     def approximate(self) -> bool:
         return self.coarse_log
+
+    @property
+    def coarse_converged(self) -> bool:
+        return self.coarse_stop_reason is StopReason.CONVERGED
+
+    @property
+    def complete(self) -> bool:
+        """As :attr:`DeformResult.complete`; the paper's transfer is complete when its coarse
+        solve is (the full-resolution shape is never iterated there)."""
+        if self.approximate:
+            return self.coarse_stop_reason is not None and self.coarse_stop_reason.complete
+        return self.stop_reason.complete
 
     @property
     def seconds(self) -> float:
@@ -133,12 +147,15 @@ class MultiresDeformer:
     constrained : (k,) int array
     labels : (k,) int array, handle group of each constrained vertex (default: the connected
         patches they form, as :class:`Deformer`)
-    size : int, wanted coarse vertex count
+    settings : Settings, optional, every solver setting (default: the defaults); its
+        ``multires_mode`` says what follows the coarse solve: full-resolution iterations to
+        ``tol`` started from it (``refine``), or the paper's transfer and nothing else
+        (``transfer``, approximate)
+    size : int, optional, wanted coarse vertex count (default: from the ``multires``
+        setting; see :func:`.size.coarse_size`)
     cache : str, optional folder for coarse meshes
-    mode : {"refine", "transfer"}, what follows the coarse solve: full-resolution iterations
-        to ``tol`` started from it, or the paper's transfer and nothing else (approximate)
     area : float, optional, ``A`` of the energy (default: area of the full mesh)
-    **options : alpha, feedback, weights, method, sweeps, as for Deformer
+    **options : any solver setting by name, over ``settings``
 
     Attributes
     ----------
@@ -157,21 +174,27 @@ class MultiresDeformer:
     """
 
     @single_threaded
-    def __init__(self, V, F, constrained, labels=None, *, size, cache=None, mode="refine",
-                 area=None, **options):
-        if mode not in MODES:
-            raise ValueError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
-        self.mode = mode
+    def __init__(self, V: ArrayLike, F: ArrayLike, constrained: ArrayLike,
+                 labels: ArrayLike | None = None, *, settings: Settings | None = None,
+                 size: int | None = None, cache: str | None = None, area: float | None = None,
+                 **options: Any) -> None:
+        self.settings = with_keywords(settings, options, ("setup", "solve", "build"),
+                                      "MultiresDeformer")
+        self.mode = mode = self.settings.multires_mode
         start = time.perf_counter()
         self.V, self.F = api_checks.mesh_arrays(V, F)
         self.constrained = api_checks.vertex_ids(constrained, len(self.V))
+        size = coarse_size(self.settings.multires, len(self.V)) if size is None else size
+        if size is None:
+            raise ValueError(f"multires {self.settings.multires} gives no coarse level for "
+                             f"{len(self.V)} vertices")
         self.labels = (connected_groups(edge_adjacency(self.F, len(self.V)), self.constrained)
                        if labels is None else np.asarray(labels, np.int64))
         self.n_groups = int(self.labels.max(initial=-1)) + 1
         groups = [self.constrained[self.labels == g] for g in range(self.n_groups)]
         # the full-resolution setup needs no coarse mesh: it runs beside the simplification
         # (738k Spot: 50 s one after the other, 35 s side by side on two cores)
-        fine = background(partial(self._fine_setup, area, options))
+        fine = background(partial(self._fine_setup, area))
         self.coarse, self.cache_hit, notes = coarse_mesh(self.V, self.F, size, groups, cache)
         self.stages = {"simplify": time.perf_counter() - start}
         self.fine, fine_setup = fine()
@@ -179,7 +202,7 @@ class MultiresDeformer:
         self.direct = self._no_gain()
         if self.direct is not None:
             return
-        self._build_coarse(cache, options)
+        self._build_coarse(cache)
         mark = time.perf_counter()
         if mode == "refine":
             self._nearest = nearest_coarse(self.fine.edges, self.coarse.vertices)
@@ -206,11 +229,11 @@ class MultiresDeformer:
         built = cls(*args, **kwargs)
         return built if built.direct is None else built.direct
 
-    def _fine_setup(self, area, options):
+    def _fine_setup(self, area):
         """The full-resolution Deformer (factored in refine mode) and its seconds."""
         mark = time.perf_counter()
-        fine = Deformer(self.V, self.F, self.constrained, area=area, labels=self.labels,
-                        prepare=False, **options)
+        fine = Deformer(self.V, self.F, self.constrained, settings=self.settings, area=area,
+                        labels=self.labels, prepare=False)
         if self.mode == "refine":
             fine.prepare()
         return fine, time.perf_counter() - mark
@@ -221,7 +244,7 @@ class MultiresDeformer:
         return {"vertices": int(self.coarse.vertices.size), "of": len(self.V),
                 "cache_hit": self.cache_hit}
 
-    def _build_coarse(self, cache, options):
+    def _build_coarse(self, cache):
         start = time.perf_counter()
         cv = self.coarse.vertices
         slot = np.full(len(self.V), -1)
@@ -232,10 +255,11 @@ class MultiresDeformer:
         labels = self.labels[self._coarse_slots]
         size = coarse_size("auto", cv.size) if self.mode == "refine" else None
         if size is None:
-            self.coarse_deformer = Deformer(*args, area=self.area, labels=labels, **options)
+            self.coarse_deformer = Deformer(*args, settings=self.settings, area=self.area,
+                                            labels=labels)
         else:  # a level between: coarse-to-fine and corrections from a coarser mesh again
             self.coarse_deformer = MultiresDeformer.or_direct(
-                *args, labels, size=size, cache=cache, area=self.area, **options)
+                *args, labels, settings=self.settings, size=size, cache=cache, area=self.area)
         self.stages["coarse_precompute"] = time.perf_counter() - start
 
     def _build_transfer(self):
@@ -249,50 +273,46 @@ class MultiresDeformer:
         self.solver = DirichletSolver(self.fine.graph.laplacian, self._known)
 
     @single_threaded
-    def solve(self, targets: ArrayLike, *, max_iter: int = DEFAULTS["max_iter"],
-              tol: float = DEFAULTS["tol"], time_limit: float | None = DEFAULTS["time_limit"],
-              accel: str = DEFAULTS["accel"], start: str = DEFAULTS["start"],
-              initial: tuple[np.ndarray, np.ndarray] | None = None,
-              callback: Callable[[dict], None] | None = None) -> "MultiresResult":
+    def solve(self, targets: ArrayLike, *, initial: tuple[np.ndarray, np.ndarray] | None = None,
+              callback: Callable[[dict], None] | None = None,
+              settings: Settings | None = None, start: str | None = None,
+              **options: Any) -> "MultiresResult":
         """Deform toward ``targets``; see :meth:`Deformer.solve` (``max_iter`` and
         ``time_limit`` hold for each level). Returns a :class:`MultiresResult`."""
         begin = time.perf_counter()
+        s = solve_settings(self.settings, settings, options, "solve")
         targets = api_checks.targets(targets, len(self.constrained))
         if initial is not None:
             initial = api_checks.initial(initial, len(self.V))
         if initial is not None and self.mode == "refine":
-            return self._warm(targets, initial, callback, tol, accel, begin,
-                              max_iter=max_iter, time_limit=time_limit, start=start)
+            return self._warm(targets, initial, callback, s, start, begin)
         cv = self.coarse.vertices
         warm = None if initial is None else (np.asarray(initial[0])[cv],
                                               np.asarray(initial[1])[cv])
-        solve_options = {"max_iter": max_iter, "tol": tol, "time_limit": time_limit,
-                         "accel": accel}
         coarse = self.coarse_deformer.solve(targets[self._coarse_slots], initial=warm,
-                                            callback=callback, start=start, **solve_options)
+                                            callback=callback, settings=s, start=start)
         stages = dict(self.stages, coarse_solve=time.perf_counter() - begin)
         log = [dict(row, step="coarse-" + row["step"]) for row in coarse.log]
         if self.mode == "transfer":
             return self._transfer(targets, coarse, log, stages, begin)
         mark = time.perf_counter()
-        first = self._fine_start(targets, tol, coarse, start)
+        first = self._fine_start(targets, s.tol, coarse, start or s.start)
         stages["fine_start"] = time.perf_counter() - mark
         mark = time.perf_counter()
         fine = self.fine.solve(targets, initial=first, start="extrapolated", callback=callback,
-                               driver=self._driver(targets, tol, accel),
-                               **solve_options)
+                               driver=self._driver(targets, s.tol, s.accel), settings=s)
         stages["fine_iterations"] = time.perf_counter() - mark
         offset, elapsed = len(log), mark - begin
         log += [dict(row, iteration=row["iteration"] + offset, seconds=row["seconds"] + elapsed)
                 for row in fine.log]
-        return MultiresResult(fine.positions, fine.rotors, log, fine.converged,
-                              fine.iterations, coarse_log=False,
+        return MultiresResult(fine.positions, fine.rotors, log, fine.stop_reason,
+                              fine.iterations, fine.stop_detail, coarse_log=False,
                               full_energy=fine.energies(), stages=stages, coarse=self.info,
                               coarse_iterations=_all_iterations(coarse),
-                              coarse_converged=coarse.converged,
+                              coarse_stop_reason=coarse.stop_reason,
                               wall=time.perf_counter() - begin)
 
-    def _warm(self, targets, initial, callback, tol, accel, begin, **limits):
+    def _warm(self, targets, initial, callback, settings, start, begin):
         """A warm start (an animation's next frame, a nearby pose) goes straight to the
         full-resolution iterations: a coarse solve first would start them farther off than
         the caller's state (50k-vertex tube twisted 3 degrees a frame: 0.63 frames/s with a
@@ -305,20 +325,21 @@ class MultiresDeformer:
         iterations, 16.6 s never corrected, 13 and 11.1 s from the first, 17 and 12.9 s after
         5)."""
         driver = None
-        if ACCEL_DRIVERS[accel] == "anderson":
+        if ACCEL_DRIVERS[settings.accel] == "anderson":
             driver = partial(anderson_iteration, correction=_Delayed(
-                partial(self.coarse_correction, targets, tol), WARM_UNCORRECTED))
-        fine = self.fine.solve(targets, initial=initial, callback=callback, tol=tol,
-                               driver=driver, accel=accel, **limits)
+                partial(self.coarse_correction, targets, settings.tol), WARM_UNCORRECTED))
+        fine = self.fine.solve(targets, initial=initial, callback=callback, settings=settings,
+                               start=start, driver=driver)
         stages = {"fine_iterations": time.perf_counter() - begin}
-        return MultiresResult(fine.positions, fine.rotors, list(fine.log), fine.converged,
-                              fine.iterations, coarse_log=False, full_energy=fine.energies(),
-                              stages=stages, coarse=self.info, coarse_converged=True,
+        return MultiresResult(fine.positions, fine.rotors, list(fine.log), fine.stop_reason,
+                              fine.iterations, fine.stop_detail, coarse_log=False,
+                              full_energy=fine.energies(), stages=stages, coarse=self.info,
                               wall=time.perf_counter() - begin)
 
-    def coarse_correction(self, targets: np.ndarray, tol: float = DEFAULTS["tol"]) -> Any:
+    def coarse_correction(self, targets: np.ndarray, tol: float | None = None) -> Any:
         """The :class:`~.correction.CoarseCorrection` of the full-resolution iterates for
-        ``targets`` (k, 3) (refine mode)."""
+        ``targets`` (k, 3) (refine mode; ``tol``: default the solver's setting)."""
+        tol = self.settings.tol if tol is None else tol
         level, coarse_targets = self.coarse_deformer, targets[self._coarse_slots]
         inner = None
         if isinstance(level, MultiresDeformer):
@@ -367,9 +388,10 @@ class MultiresDeformer:
         rest = self.V.copy()
         rest[self.constrained] = targets
         start = self.fine.energy(rest, np.tile(IDENTITY, (len(self.V), 1)))
-        return MultiresResult(P, R, log, False, 0, full_energy=energy, stages=stages,
-                              coarse=self.info, coarse_iterations=_all_iterations(coarse),
-                              coarse_converged=coarse.converged, start_energy=start,
+        return MultiresResult(P, R, log, StopReason.TRANSFER, 0, full_energy=energy,
+                              stages=stages, coarse=self.info,
+                              coarse_iterations=_all_iterations(coarse),
+                              coarse_stop_reason=coarse.stop_reason, start_energy=start,
                               wall=time.perf_counter() - begin)
 
     def _known_rotors(self, targets, coarse_rotors):

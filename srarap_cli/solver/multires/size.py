@@ -21,22 +21,31 @@ MIN_SIZE = 4
 
 
 def parse_size(text):
-    """Validate a multires setting: ``"off"``, ``"auto"``, an int >= 4 or ``"P%"``.
+    """Validate a multires setting: ``"off"``, ``"auto"``, an int >= 4, ``"P%"`` or a
+    fraction strictly between 0 and 1 (``0.02``: what ``"2%"`` parses to).
 
     Returns the setting normalized (``"off"``, ``"auto"``, an int or a float fraction);
-    raises ValueError with a one-line reason.
+    raises ValueError with a one-line reason. Parsing is idempotent: a parsed value parses to
+    itself, so a setting may pass through any number of layers (handle file, manifest,
+    command line, Python keywords) unchanged.
 
     Examples
     --------
-    >>> parse_size("2%"), parse_size("5000"), parse_size(" off ")
-    (0.02, 5000, 'off')
+    >>> parse_size("2%"), parse_size("5000"), parse_size(" off "), parse_size(0.02)
+    (0.02, 5000, 'off', 0.02)
+    >>> parse_size(parse_size("2%")) == parse_size("0.02") == 0.02
+    True
     """
+    if isinstance(text, float):
+        return _fraction(text)
     if isinstance(text, int) and not isinstance(text, bool):
         value = text
     else:
         s = str(text).strip().lower()
         if s in ("off", "auto"):
             return s
+        if re.fullmatch(r"\d*\.\d+|\d+\.", s):
+            return _fraction(float(s))
         match = re.fullmatch(r"(\d+(?:\.\d*)?)\s*%", s)
         if match:
             fraction = float(match.group(1)) / 100
@@ -44,11 +53,19 @@ def parse_size(text):
                 raise ValueError("a percentage must be above 0% and below 100%")
             return fraction
         if not re.fullmatch(r"\d+", s):
-            raise ValueError("must be off, auto, a vertex count or a percentage like 2%")
+            raise ValueError("must be off, auto, a vertex count, a percentage like 2% or a "
+                             "fraction like 0.02")
         value = int(s)
     if value < MIN_SIZE:
         raise ValueError(f"a coarse vertex count must be at least {MIN_SIZE}")
     return value
+
+
+def _fraction(value):
+    if not 0 < value < 1:
+        raise ValueError("a fraction of the vertices must be above 0 and below 1 "
+                         "(a vertex count is a whole number)")
+    return float(value)
 
 
 def coarse_size(setting, n):

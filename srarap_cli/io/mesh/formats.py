@@ -1,0 +1,223 @@
+"""The one table of mesh formats: name, extensions, reader, writer, read-memory factor and a
+content signature. The command line's choices and help, the memory guard, ``read_mesh``,
+``write_mesh``, standard input's format detection and the README's format table all come
+from :data:`FORMATS`; a new format is one :func:`register_format` call (from any module,
+inside the package or not) and nothing else.
+"""
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .mesh import Mesh
+from .normals import recompute_normals
+from .obj import format_obj, obj_frames, read_obj
+from .off import format_off, read_off
+from .ply import format_ply, per_vertex
+from .ply_read import read_ply
+from .stl import format_stl, read_stl
+
+#: what a writer returns: the file's bytes and a warning per kind of data the format lost
+Written = tuple[bytes, list[str]]
+
+
+@dataclass(frozen=True)
+class MeshFormat:
+    """One mesh file format.
+
+    Attributes
+    ----------
+    name : str, the value of ``--input-format`` and ``--format`` (``obj``)
+    extensions : tuple of str, lower-case with the dot (``(".obj",)``); the first is the
+        one this format is known by
+    read : callable(path) -> Mesh, raising InputError for a bad file
+    write : callable(mesh, ascii) -> (bytes, warnings); ``ascii`` asks for a text variant
+        where the format has one (``has_ascii``)
+    read_factor : float, bytes of memory parsing holds per byte of file (the memory guard
+        refuses a file whose parse would not fit)
+    signature : callable(head, size) -> bool, whether content starting with the bytes
+        ``head`` (up to :data:`HEAD_BYTES`) in a file of ``size`` bytes is of this format
+    description : str, one line for the README's table
+    signature_rank : int, signatures are asked in this order (lowest first): an exact test
+        (binary STL's size, PLY's magic line) before one on first words (OFF, OBJ)
+    has_ascii : bool, ``--ascii`` applies
+    keeps_vertex_data : bool, other per-vertex properties (``Mesh.vertex_data``) are
+        written (``--write-distortion`` applies)
+    frames : callable(mesh) -> callable(positions) -> bytes, optional; the bytes of
+        ``mesh`` with other positions, faster than ``write`` per frame (animations)
+    """
+
+    name: str
+    extensions: tuple[str, ...]
+    read: Callable[[str], Mesh]
+    write: Callable[[Mesh, bool], Written]
+    read_factor: float
+    signature: Callable[[bytes, int], bool]
+    description: str = ""
+    signature_rank: int = 50
+    has_ascii: bool = False
+    keeps_vertex_data: bool = False
+    frames: Callable[[Mesh], Callable[[np.ndarray], bytes]] | None = None
+
+    @property
+    def extension(self) -> str:
+        return self.extensions[0]
+
+    def frame_writer(self, mesh: Mesh) -> Callable[[np.ndarray], bytes]:
+        """``frame(positions) -> bytes``: the file of ``mesh`` with other positions (n, 3)."""
+        if self.frames is not None:
+            return self.frames(mesh)
+        return lambda positions: self.write(mesh.with_vertices(positions), False)[0]
+
+
+#: bytes of a file's start that the signatures look at
+HEAD_BYTES = 4096
+FORMATS: dict[str, MeshFormat] = {}
+
+
+def register_format(fmt: MeshFormat) -> MeshFormat:
+    """Add ``fmt`` to :data:`FORMATS` (replacing a format of the same name). Raises
+    ValueError when another format already claims one of its extensions."""
+    for other in FORMATS.values():
+        taken = set(other.extensions) & set(fmt.extensions)
+        if other.name != fmt.name and taken:
+            raise ValueError(f"extension {sorted(taken)[0]} is already {other.name}'s")
+    FORMATS[fmt.name] = fmt
+    return fmt
+
+
+def format_names() -> list[str]:
+    """The registered format names, in registration order."""
+    return list(FORMATS)
+
+
+def extensions() -> list[str]:
+    """Every registered extension (``.obj``, ...)."""
+    return [ext for fmt in FORMATS.values() for ext in fmt.extensions]
+
+
+def by_extension(path: str) -> MeshFormat | None:
+    """The format of ``path``'s extension (any case), or None."""
+    match = re.search(r"\.[^./\\]+$", str(path))
+    ext = match.group(0).lower() if match else ""
+    return next((fmt for fmt in FORMATS.values() if ext in fmt.extensions), None)
+
+
+def by_content(head: bytes, size: int) -> MeshFormat | None:
+    """The format whose signature accepts ``head`` (a file's first bytes) and ``size``,
+    asked by ``signature_rank``, or None."""
+    ranked = sorted(FORMATS.values(), key=lambda fmt: fmt.signature_rank)
+    return next((fmt for fmt in ranked if fmt.signature(head, size)), None)
+
+
+def markdown_table() -> str:
+    """The formats as the README's Markdown table (a test keeps the two equal)."""
+    rows = ["| format | extensions | reads and writes |", "|---|---|---|"]
+    for fmt in FORMATS.values():
+        rows.append(f"| `{fmt.name}` | {', '.join(f'`{e}`' for e in fmt.extensions)} | "
+                     f"{fmt.description} |")
+    return "\n".join(rows) + "\n"
+
+
+def _first_words(head: bytes) -> list[bytes]:
+    """The first word of each of the first lines of ``head`` that hold anything but a
+    comment (``#``), a byte-order mark skipped."""
+    text = head.removeprefix(b"\xef\xbb\xbf")
+    words = []
+    for line in text.splitlines()[:-1] or text.splitlines():
+        line = line.split(b"#", 1)[0].split()
+        if line:
+            words.append(line[0])
+    return words
+
+
+def _is_ply(head: bytes, size: int) -> bool:
+    return re.match(rb"(\xef\xbb\xbf)?ply\r?\n", head) is not None
+
+
+def _is_binary_stl(head: bytes, size: int) -> bool:
+    if size < 84 or len(head) < 84:
+        return False
+    return 84 + 50 * int(np.frombuffer(head[80:84], "<u4")[0]) == size
+
+
+def _is_ascii_stl(head: bytes, size: int) -> bool:
+    words = _first_words(head)
+    return bool(words) and words[0].lower() == b"solid" and not _is_binary_stl(head, size)
+
+
+def _is_stl(head: bytes, size: int) -> bool:
+    return _is_binary_stl(head, size) or _is_ascii_stl(head, size)
+
+
+def _is_off(head: bytes, size: int) -> bool:
+    words = _first_words(head)
+    return bool(words) and words[0].upper().endswith(b"OFF")
+
+
+_OBJ_WORDS = {b"v", b"vt", b"vn", b"vp", b"f", b"l", b"p", b"o", b"g", b"s", b"mtllib",
+              b"usemtl", b"cstype", b"deg", b"curv", b"surf"}
+
+
+def _is_obj(head: bytes, size: int) -> bool:
+    words = _first_words(head)
+    return bool(words) and all(w in _OBJ_WORDS for w in words[:8])
+
+
+def _write_obj(mesh: Mesh, ascii: bool) -> Written:
+    return format_obj(mesh).encode("utf-8"), []
+
+
+def _write_stl(mesh: Mesh, ascii: bool) -> Written:
+    lost = []
+    if (mesh.face_sizes != 3).any() or mesh.uv is not None or mesh.normals is not None:
+        lost.append("STL keeps only triangles in single precision: polygons split, "
+                    "texture coordinates and normals not written, vertices not shared")
+    return format_stl(mesh), lost
+
+
+def _per_vertex_only(mesh: Mesh, name: str) -> tuple[Mesh, list[str]]:
+    """``mesh`` as a format with at most one texture coordinate and normal per vertex can
+    hold it: per-corner normals averaged per vertex, a warning for lost coordinates."""
+    lost = []
+    if mesh.uv is not None and (name == "off" or per_vertex(mesh, mesh.uv, mesh.face_uv) is None):
+        lost.append(f"texture coordinates not written: {name.upper()} stores at most one "
+                    "per vertex; write .obj to keep them")
+    if mesh.normals is not None and per_vertex(mesh, mesh.normals, mesh.face_normals) is None:
+        out = Mesh(**{k: getattr(mesh, k) for k in mesh.__dataclass_fields__})
+        out.normals = np.zeros_like(mesh.vertices)
+        out.face_normals = mesh.face_vertices
+        out.normals = recompute_normals(out)
+        mesh = out
+    return mesh, lost
+
+
+def _write_off(mesh: Mesh, ascii: bool) -> Written:
+    mesh, lost = _per_vertex_only(mesh, "off")
+    return format_off(mesh).encode("ascii"), lost
+
+
+def _write_ply(mesh: Mesh, ascii: bool) -> Written:
+    mesh, lost = _per_vertex_only(mesh, "ply")
+    return format_ply(mesh, ascii), lost
+
+
+# Measured on this project's machines (README, "Limits"): parsing text meshes holds about 17x
+# the file size; binary ones a few times. The factors carry a safety margin.
+register_format(MeshFormat(
+    "obj", (".obj",), read_obj, _write_obj, 20, _is_obj,
+    "polygons, texture coordinates, normals and statements (`mtllib`, `usemtl`, `g`, `s`) "
+    "kept", signature_rank=90, frames=obj_frames))
+register_format(MeshFormat(
+    "off", (".off",), read_off, _write_off, 20, _is_off,
+    "ASCII, with the NOFF/COFF/STOFF prefixes; per-vertex normals kept", signature_rank=80))
+register_format(MeshFormat(
+    "ply", (".ply",), read_ply, _write_ply, 6, _is_ply,
+    "binary (default) or ASCII (`--ascii`); per-vertex normals, texture coordinates and "
+    "other per-vertex properties kept", signature_rank=10, has_ascii=True,
+    keeps_vertex_data=True))
+register_format(MeshFormat(
+    "stl", (".stl",), read_stl, _write_stl, 6, _is_stl,
+    "binary or ASCII in, binary out; corners welded into shared vertices on reading, "
+    "triangles only", signature_rank=0))
