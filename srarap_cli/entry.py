@@ -10,7 +10,7 @@ import sys
 from .runtime import clock, signals  # noqa: F401 -- the clock starts with the process
 
 
-def main():
+def main() -> None:
     signals.own()
     code = 1
     try:

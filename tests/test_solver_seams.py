@@ -51,6 +51,7 @@ def test_a_driver_registered_from_a_test_file_runs_through_the_public_api(bent):
     finally:
         DRIVERS.pop("test-at-most-three")
     assert capped.iterations == 3 and len(capped.log) == 4 and not capped.converged
+    assert capped.stop_reason is StopReason.DRIVER and not capped.complete
     # the same three steps as the plain driver capped by max_iter: identical iterates
     assert np.array_equal(capped.positions, plain.positions)
     assert [r["total"] for r in capped.log] == [r["total"] for r in plain.log]

@@ -2,11 +2,18 @@
 
 Subcommand modules are imported only when their command runs, so that ``srarap --help`` does
 not load the numerical stack (about a second).
+
+Rule: imports ``tasks``, ``io``, ``solver`` and ``runtime`` (the top layer: options, exit
+codes, summaries); only ``srarap_cli.entry`` imports it.
 """
 import importlib
 import sys
+from collections.abc import Sequence
+from typing import Any
 
 import click
+from click.core import Command, Context
+from click.formatting import HelpFormatter
 
 from ..runtime import signals, streams
 from ..runtime.lazy_modules import defer_unused_numpy_modules
@@ -37,10 +44,10 @@ COMMANDS = {
 class LazyGroup(click.Group):
     """A group whose commands are imported on first use."""
 
-    def list_commands(self, ctx):
+    def list_commands(self, ctx: Context) -> list[str]:
         return list(COMMANDS)
 
-    def get_command(self, ctx, name):
+    def get_command(self, ctx: Context, name: str) -> Command | None:
         if name not in COMMANDS:
             return None
         module, attr, _ = COMMANDS[name]
@@ -48,8 +55,9 @@ class LazyGroup(click.Group):
         defer_unused_numpy_modules()
         return getattr(importlib.import_module(f".{module}", __name__), attr)
 
-    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True,
-             **extra):
+    def main(self, args: Sequence[str] | None = None, prog_name: str | None = None,  # type: ignore[override]
+             complete_var: str | None = None, standalone_mode: bool = True,
+             **extra: Any) -> Any:
         """Click's main, with its errors as one ``srarap: error:`` line like every other
         failure (Click prints a usage block first), exit code 2 for bad usage."""
         if not standalone_mode:
@@ -77,7 +85,7 @@ class LazyGroup(click.Group):
             sys.exit(130)
         sys.exit(code if isinstance(code, int) else 0)
 
-    def format_commands(self, ctx, formatter):
+    def format_commands(self, ctx: Context, formatter: HelpFormatter) -> None:
         with formatter.section("Commands"):
             formatter.write_dl([(name, short) for name, (_, _, short) in COMMANDS.items()])
 
@@ -85,5 +93,5 @@ class LazyGroup(click.Group):
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--debug", is_flag=True, help="Show tracebacks of failures.")
 @click.version_option(package_name="srarap-cli", prog_name="srarap")
-def main(debug):
+def main(debug: bool) -> None:
     """Deform triangle meshes as rigidly as possible with smooth rotations (SR-ARAP)."""

@@ -5,6 +5,7 @@ import re
 import string
 import sys
 import time
+from typing import Any
 
 import click
 
@@ -58,8 +59,10 @@ MAX_FRAMES = 100_000
 @cache_option
 @with_verbosity
 @guarded
-def animate(mesh, handles, pattern, frames, fps, max_frames, iters_per_frame, keep_unconverged,
-            log, resume, overrides, cache, verbosity):
+def animate(mesh: str, handles: str, pattern: str, frames: int | None, fps: float | None,
+            max_frames: int, iters_per_frame: int | None, keep_unconverged: bool,
+            log: str | None, resume: bool, overrides: dict[str, Any], cache: str | None,
+            verbosity: int | None) -> None:
     """Deform MESH through the keyframes of HANDLES, writing one mesh per frame.
 
     Each frame starts from the frames before it and iterates to --tol (at most --max-iter

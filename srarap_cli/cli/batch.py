@@ -28,7 +28,8 @@ from .common import guarded
               help="Write the mesh of a job that did not converge (exit code still 3).")
 @click.option("-q", "--quiet", is_flag=True, help="No summary table.")
 @guarded
-def batch(manifest, workers, scheduler, out, keep_unconverged, quiet):
+def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unconverged: bool,
+          quiet: bool) -> None:
     """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
 
     Exit code 0 when every job is ok or up to date, 8 when any job failed or regressed

@@ -1,5 +1,6 @@
 """``srarap bench``: every method on one problem, compared on wall time to a given energy."""
 import os
+from typing import Any
 
 import click
 
@@ -34,7 +35,8 @@ BENCH_FILES = ("curves.csv", "summary.json", "energy.png")
 @settings_options(exclude=("method", "multires", "multires_mode", "time_limit", "accel", "start"),
                defaults=OWN_DEFAULTS)
 @guarded
-def bench(mesh, handles, methods, time_budget, out, overrides):
+def bench(mesh: str, handles: str, methods: str, time_budget: float, out: str | None,
+          overrides: dict[str, Any]) -> None:
     """Run each method on MESH + HANDLES from the same start and compare them.
 
     Reports per-iteration time, iterations and seconds to come within 1% and 0.1% of the lowest

@@ -5,6 +5,8 @@ import os
 import sys
 import traceback
 from collections import Counter
+from collections.abc import Callable, Sequence
+from typing import Any, NoReturn
 
 import click
 import numpy as np
@@ -12,6 +14,7 @@ import numpy as np
 from ..io.handles import referenced_files
 from ..io.mesh import FORMATS, MeshFormat, read_mesh
 from ..io.mesh.formats import by_extension
+from ..io.mesh.mesh import Mesh
 from ..io.mesh.stream import read_mesh_stream
 from ..runtime import exit_codes, signals, streams
 from ..runtime.clock import elapsed
@@ -20,9 +23,10 @@ from ..runtime.errors import InputError, NumericalError, OutputError, SingularSy
 from ..runtime.limits import is_out_of_memory, memory_note
 from ..runtime.paths import refuse_overwriting_inputs
 from ..runtime.signals import Terminated
+from ..solver.deformer import DeformResult
 
 
-def fail(code, message):
+def fail(code: int, message: str) -> NoReturn:
     """One line on stderr (a file name holding a newline is printed escaped) and ``code``."""
     streams.release()
     line = message.replace("\n", "\\n").replace("\r", "\\r")
@@ -33,7 +37,7 @@ def fail(code, message):
     sys.exit(code)
 
 
-def write_stdout(data):
+def write_stdout(data: bytes) -> None:
     """``data`` (bytes) to standard output; a full device or a closed pipe is an output error
     and a broken pipe respectively, never an internal one."""
     try:
@@ -45,7 +49,7 @@ def write_stdout(data):
         raise OutputError(f"<stdout>: cannot write: {exc.strerror or exc}") from None
 
 
-def guarded(func):
+def guarded(func: Callable[..., None]) -> Callable[..., None]:
     """Turn known failures into one stderr line and a documented exit code."""
 
     @functools.wraps(func)
@@ -89,7 +93,7 @@ def _quiet_stdout():
         pass
 
 
-def written():
+def written() -> str:
     """What the run had committed when a signal stopped it (an animation's resume state is
     not named, but said to be there)."""
     files = list(dict.fromkeys(p for p in COMMITTED
@@ -122,7 +126,7 @@ def _classify(exc):
                                        "(rerun with --debug for the traceback and report it)")
 
 
-def check_output_path(path, allowed, what):
+def check_output_path(path: str, allowed: Sequence[str], what: str) -> None:
     """Fail before any work when an output could not be written."""
     ext = os.path.splitext(path)[1].lower()
     if ext not in allowed:
@@ -136,7 +140,7 @@ def check_output_path(path, allowed, what):
         raise OutputError(f"{path}: is a folder")
 
 
-def wall_seconds(result):
+def wall_seconds(result: DeformResult) -> float:
     """The process's wall seconds for a summary (the solve's own when srarap runs inside
     another program, whose clock did not start with srarap)."""
     return elapsed() if signals.OWNED else result.seconds
@@ -150,14 +154,15 @@ verbosity_options = [
 ]
 
 
-def with_verbosity(func):
+def with_verbosity(func: Callable[..., None]) -> Callable[..., None]:
     """``-q`` / ``-v``: the command receives ``verbosity`` 0, 1 (default) or 2."""
     for option in reversed(verbosity_options):
         func = option(func)
     return func
 
 
-def report(verbosity, *, warnings=(), details=(), summary=None):
+def report(verbosity: int | None, *, warnings: Sequence[str] = (), details: Sequence[str] = (),
+           summary: str | None = None) -> None:
     """Print what a run has to say on stderr: each distinct warning once (with how many times
     it came up), the detail lines with ``-v``, the summary line unless ``-q``."""
     counts = Counter(warnings)
@@ -170,14 +175,17 @@ def report(verbosity, *, warnings=(), details=(), summary=None):
         click.echo(summary, err=True)
 
 
-def finite_option(_ctx, _param, value):
+def finite_option(_ctx: click.Context, _param: click.Parameter,
+                  value: float | None) -> float | None:
     """Click callback: a float option must be finite (FloatRange lets inf through)."""
     if value is not None and not math.isfinite(value):
         raise click.BadParameter("must be a finite number")
     return value
 
 
-def refuse_overwrite(outputs, *, mesh=None, handles=None, others=()):
+def refuse_overwrite(outputs: Sequence[str | None], *, mesh: str | None = None,
+                     handles: str | None = None,
+                     others: Sequence[tuple[str, str]] = ()) -> None:
     """Fail (exit 4) before any work when an output is one of the run's inputs: the mesh, the
     handle file, the files it names, or ``others`` ((what, path) pairs)."""
     inputs = [("mesh", mesh)] if mesh not in (None, "-") else []
@@ -188,13 +196,16 @@ def refuse_overwrite(outputs, *, mesh=None, handles=None, others=()):
                               inputs + list(others))
 
 
-def read_any_mesh(path, input_format=None):
+def read_any_mesh(path: str, input_format: MeshFormat | None = None
+                  ) -> tuple[Mesh, MeshFormat]:
     """``(mesh, format)``: the file ``path`` (by its extension), or standard input for ``-``
     (as ``input_format``, a :class:`~srarap_cli.io.mesh.MeshFormat`, or the format its bytes
     show)."""
     if path == "-":
         return read_mesh_stream(sys.stdin.buffer if sys.stdin else None, input_format)
-    return read_mesh(path), by_extension(path)
+    fmt = by_extension(path)
+    assert fmt is not None  # read_mesh refuses what no format claims
+    return read_mesh(path), fmt
 
 
 class MeshFormatType(click.ParamType):
@@ -204,10 +215,11 @@ class MeshFormatType(click.ParamType):
 
     name = "format"
 
-    def get_metavar(self, param, ctx):
+    def get_metavar(self, param: click.Parameter, ctx: click.Context) -> str:
         return "[" + "|".join(FORMATS) + "]"
 
-    def convert(self, value, param, ctx):
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> MeshFormat:
         if isinstance(value, MeshFormat):
             return value
         fmt = FORMATS.get(str(value).lower())

@@ -3,6 +3,7 @@ import json
 
 import click
 
+from ..io.mesh.formats import MeshFormat
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..tasks.compare import compare_meshes
@@ -20,7 +21,8 @@ from .common import check_output_path, guarded, input_format_option, read_any_me
 @click.option("-q", "--quiet", is_flag=True, help="No summary line.")
 @input_format_option
 @guarded
-def compare(a, b, tol, relative, report, quiet, input_format):
+def compare(a: str, b: str, tol: float, relative: bool, report: str | None, quiet: bool,
+            input_format: MeshFormat | None) -> None:
     """Compare meshes A and B: per vertex when they have the same vertices and faces, else by
     the symmetric Hausdorff distance of their surfaces.
 

@@ -2,12 +2,13 @@
 import math
 import os
 import sys
+from typing import Any
 
 import click
 
 from ..io.handles import load_handles
 from ..io.mesh import FORMATS
-from ..io.mesh.formats import by_extension, extensions
+from ..io.mesh.formats import MeshFormat, by_extension, extensions
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
@@ -60,8 +61,10 @@ from .progress import SolveProgress
               help="Write the mesh even when the solve did not converge (exit code still 3).")
 @with_verbosity
 @guarded
-def deform(mesh, handles, out, input_format, out_format, ascii, log, overrides, cache, preview,
-           preview_up, write_distortion, keep_unconverged, verbosity):
+def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
+           out_format: MeshFormat | None, ascii: bool, log: str | None,
+           overrides: dict[str, Any], cache: str | None, preview: str | None, preview_up: str,
+           write_distortion: bool, keep_unconverged: bool, verbosity: int | None) -> None:
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.

@@ -4,6 +4,7 @@ import json
 import click
 
 from ..io.handles import load_handles
+from ..io.mesh.formats import MeshFormat
 from ..tasks.info import handles_info, mesh_info
 from .common import guarded, input_format_option, read_any_mesh
 
@@ -14,7 +15,8 @@ from .common import guarded, input_format_option, read_any_mesh
 @input_format_option
 @click.option("--json", "as_json", is_flag=True, help="One JSON document on standard output.")
 @guarded
-def info(mesh, handles, input_format, as_json):
+def info(mesh: str, handles: str | None, input_format: MeshFormat | None,
+         as_json: bool) -> None:
     """Describe MESH and what HANDLES selects and does, without solving.
 
     The mesh: counts, extent per axis, problems. With HANDLES, each group's vertices and

@@ -4,6 +4,8 @@ The solver's settings module knows nothing of Click; this is the only place the 
 command-line flags.
 """
 import functools
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any, TypeVar
 
 import click
 
@@ -11,8 +13,11 @@ from ..solver.multires.size import parse_size
 from ..solver.settings import SETTINGS, Setting
 from .common import finite_option
 
+#: a command function a decorator wraps
+F = TypeVar("F", bound=Callable[..., Any])
 
-def setting_option(setting: Setting, default=None):
+
+def setting_option(setting: Setting, default: object = None) -> Callable[[F], F]:
     """The Click option of one setting; its value is None unless given (the handle file and
     the defaults fill in). ``default`` replaces the shown default where a command has its own."""
     shown = setting.default if default is None else default
@@ -23,7 +28,8 @@ def setting_option(setting: Setting, default=None):
         return click.option(setting.flag, callback=_size_option, metavar=setting.metavar,
                             help=text)
     elif setting.kind == "int":
-        kind, callback = click.IntRange(min=setting.minimum, min_open=setting.strict), None
+        low = None if setting.minimum is None else int(setting.minimum)
+        kind, callback = click.IntRange(min=low, min_open=setting.strict), None
     else:
         kind = click.FloatRange(min=setting.minimum, min_open=setting.strict)
         callback = finite_option
@@ -40,7 +46,8 @@ def _size_option(_ctx, _param, value):
         raise click.BadParameter(str(exc)) from None
 
 
-def settings_options(*, exclude=(), defaults=None):
+def settings_options(*, exclude: Sequence[str] = (),
+                     defaults: Mapping[str, object] | None = None) -> Callable[[F], F]:
     """Decorator: one Click option per setting (bar ``exclude``); the command receives them
     together as ``overrides``, a dict of name -> value or None. ``defaults`` replaces the
     shown default where a command has its own (``bench``'s ``tol``)."""

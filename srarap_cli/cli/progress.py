@@ -1,6 +1,7 @@
 """A one-line progress display for long solves, on a terminal only."""
 import sys
 import time
+from typing import Any
 
 #: Seconds before the line appears (short runs stay silent) and between redraws.
 DELAY, EVERY = 2.0, 0.2
@@ -13,13 +14,13 @@ class SolveProgress:
     ``close`` clears the line so the summary that follows starts clean.
     """
 
-    def __init__(self, enabled):
+    def __init__(self, enabled: bool) -> None:
         self.enabled = enabled
         self.start = time.perf_counter()
         self.last = 0.0
         self.shown = False
 
-    def __call__(self, row):
+    def __call__(self, row: dict[str, Any]) -> None:
         if not self.enabled:
             return
         now = time.perf_counter() - self.start
@@ -30,7 +31,7 @@ class SolveProgress:
                          f"change {row['rel_change']:.2g}  {now:.1f} s ")
         sys.stderr.flush()
 
-    def close(self):
+    def close(self) -> None:
         if self.shown:
             sys.stderr.write("\r\033[K")
             sys.stderr.flush()

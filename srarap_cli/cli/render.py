@@ -9,13 +9,14 @@ import numpy as np
 
 from ..io.handles import load_handles
 from ..io.mesh import read_mesh
+from ..io.mesh.formats import MeshFormat
 from ..runtime.commit import commit_files
 from ..tasks.preview import preview_png
 from ..tasks.render import VIEWS
 from .common import check_output_path, guarded, input_format_option, read_any_mesh, refuse_overwrite
 
 
-def parse_size(text):
+def parse_size(text: str) -> tuple[int, int]:
     try:
         w, h = (int(x) for x in text.lower().split("x"))
     except ValueError:
@@ -46,7 +47,8 @@ def parse_size(text):
 @click.option("--size", default="800x600", show_default=True, help="WIDTHxHEIGHT in pixels.")
 @input_format_option
 @guarded
-def render(mesh, out, handles, rest, color, layout, up, views, size, input_format):
+def render(mesh: str, out: str, handles: str | None, rest: str | None, color: str, layout: str,
+           up: str, views: tuple[str, ...], size: str, input_format: MeshFormat | None) -> None:
     """Render MESH to a PNG, headless."""
     check_output_path(out, (".png",), "output")
     size = parse_size(size)
@@ -82,7 +84,7 @@ def _check_view(view):
 @click.option("-o", "--output", "out", required=True, help="PNG to write.")
 @click.option("--size", default="1000x420", show_default=True, help="WIDTHxHEIGHT in pixels.")
 @guarded
-def plot(logs, out, size):
+def plot(logs: tuple[str, ...], out: str, size: str) -> None:
     """Plot total energy against iteration and time for one or more deform logs (CSV/JSONL)."""
     check_output_path(out, (".png",), "output")
     refuse_overwrite([out], others=[("log", path) for path in logs])

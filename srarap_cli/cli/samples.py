@@ -17,7 +17,7 @@ SUBFOLDERS = ("sample_meshes", "configs", "golden")
 @click.option("--force", is_flag=True, help="Replace files of the same names in FOLDER.")
 @click.option("-q", "--quiet", is_flag=True, help="No summary line.")
 @guarded
-def samples(folder, force, quiet):
+def samples(folder: str, force: bool, quiet: bool) -> None:
     """Copy the sample meshes, handle files and goldens into FOLDER (three subfolders).
 
     Then, for example: srarap deform FOLDER/sample_meshes/bar.obj FOLDER/configs/bar-twist.yaml

@@ -6,6 +6,7 @@ before anything walks the document: the composed YAML graph is measured with ali
 as often as they are used, in time linear in the graph's size.
 """
 import json
+from typing import Any
 
 import yaml
 
@@ -20,7 +21,7 @@ MAX_NODES = 1_000_000
 MAX_DEPTH = 100
 
 
-def load_document(path, kind):
+def load_document(path: str, kind: str) -> Any:
     """Parsed content of ``path``; ``kind`` is ``"json"`` or ``"yaml"`` (JSON is YAML too).
 
     Raises

@@ -10,13 +10,14 @@ that writes one reads exactly like the same file without it.
 """
 import os
 import stat
+from typing import IO, Any
 
 from ..runtime.errors import InputError
 
 BOM = b"\xef\xbb\xbf"
 
 
-def open_input(path, mode="r", **kwargs):
+def open_input(path: str | os.PathLike, mode: str = "r", **kwargs: Any) -> IO[Any]:
     """``open(path, mode, **kwargs)`` for reading, refusing anything but a regular file; in
     binary mode the stream starts after a leading UTF-8 byte order mark, in text mode
     ``utf-8`` is read as ``utf-8-sig`` (the same).
@@ -64,7 +65,7 @@ def open_input(path, mode="r", **kwargs):
         raise
 
 
-def read_input_bytes(path):
+def read_input_bytes(path: str | os.PathLike) -> bytes:
     """The whole content of a regular file, less a leading byte order mark (see
     :func:`open_input`)."""
     with open_input(path, "rb") as fh:

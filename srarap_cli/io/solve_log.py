@@ -3,6 +3,7 @@
 import io
 import json
 import math
+from typing import Any
 
 LOG_FORMATS = (".csv", ".jsonl", ".ndjson")
 #: ``stop``: empty but on the row where a solve (or a multiresolution level) stopped, which
@@ -11,7 +12,8 @@ LOG_FIELDS = ("iteration", "membrane", "bending", "total", "rel_change", "max_mo
               "step", "stop")
 
 
-def format_log(rows, suffix, fields=LOG_FIELDS):
+def format_log(rows: list[dict[str, Any]], suffix: str,
+               fields: tuple[str, ...] = LOG_FIELDS) -> str:
     """Log text for ``rows`` (dicts with ``fields``); numbers with full precision, NaN as an
     empty cell (null in JSON), booleans as ``true``/``false``.
 

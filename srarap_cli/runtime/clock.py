@@ -6,6 +6,6 @@ import time
 STARTED = time.perf_counter()
 
 
-def elapsed():
+def elapsed() -> float:
     """Wall seconds since :data:`STARTED`."""
     return time.perf_counter() - STARTED

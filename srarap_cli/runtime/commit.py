@@ -10,11 +10,11 @@ from .errors import OutputError
 
 #: Paths this process has committed, in order: a signal that arrives after a commit is
 #: reported with what was written, not as "no output written".
-COMMITTED = []
+COMMITTED: list[str] = []
 _SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
-def commit_files(files):
+def commit_files(files: list[tuple[str, bytes]]) -> None:
     """Write ``[(path, bytes), ...]`` as one unit: on any failure every target is left exactly
     as it was (not created, or its old content).
 
@@ -104,9 +104,9 @@ def _remove(tmp):
             pass
 
 
-def atomic_write(path, data):
+def atomic_write(path: str | os.PathLike, data: bytes) -> None:
     """Write bytes to ``path`` via a temporary file in the same folder and a rename."""
-    commit_files([(path, data)])
+    commit_files([(os.fspath(path), data)])
 
 
 def _stage(path, data):

@@ -17,7 +17,7 @@ class SingularSystemError(RuntimeError):
     """A factorization met a singular matrix (for example a part with no constraint)."""
 
 
-def excerpt(text, limit=40):
+def excerpt(text: object, limit: int = 40) -> str:
     """A short, printable excerpt of user-supplied text for an error message (the file
     could be anything, a symlinked system file included: quote little of it).
 

@@ -12,12 +12,14 @@ the caller computes the result itself, so results never depend on this.
 import os
 import sys
 import warnings
+from collections.abc import Callable
+from typing import Any
 
 #: macOS lists fork, but forking a process that has loaded system frameworks is unsafe there
 _FORK_OK = hasattr(os, "fork") and sys.platform.startswith("linux")
 
 
-def run_forked(func, *args):
+def run_forked(func: Callable, *args: Any) -> bytes | None:
     """``func(*args)``, which returns bytes, computed in a forked child.
 
     Returns

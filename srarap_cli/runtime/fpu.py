@@ -14,6 +14,7 @@ The setting is the SSE control register (MXCSR) of the calling thread, set throu
 import contextlib
 import ctypes
 import platform
+from collections.abc import Iterator
 
 # fenv_t on x86-64 glibc: the x87 environment (28 bytes), then MXCSR
 _FENV_WORDS = 8
@@ -36,7 +37,7 @@ _LIBM = _libm()
 
 
 @contextlib.contextmanager
-def subnormals_flushed():
+def subnormals_flushed() -> Iterator[None]:
     """Within the block, subnormal inputs and results count as zero (this thread only).
 
     Examples

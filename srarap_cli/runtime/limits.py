@@ -74,7 +74,7 @@ def _cgroup():
     return None
 
 
-def available_memory():
+def available_memory() -> int | None:
     """Bytes srarap may plan to use (see the module's docstring), or None if unknown."""
     if os.environ.get(ENV, "").strip():
         return _from_env()
@@ -82,7 +82,7 @@ def available_memory():
     return min(known) if known else None
 
 
-def memory_note():
+def memory_note() -> str:
     """Where the process's memory bound comes from, for messages."""
     if os.environ.get(ENV, "").strip():
         return f"{ENV}={os.environ[ENV].strip()}"
@@ -93,7 +93,7 @@ def memory_note():
     return "the memory available"
 
 
-def is_out_of_memory(exc):
+def is_out_of_memory(exc: BaseException) -> bool:
     """Whether ``exc`` is a failed allocation reported as something else (SuperLU's malloc
     failures arrive as RuntimeError, C++'s bad_alloc as various types)."""
     text = str(exc).lower()
@@ -107,7 +107,7 @@ def _refuse(what, need, have):
                      "change the assumption)")
 
 
-def check_read(path, factor):
+def check_read(path: str | os.PathLike, factor: float) -> None:
     """Before reading: refuse a mesh file whose parsing would not fit, ``factor`` being the
     bytes of memory parsing holds per byte of the file."""
     have = available_memory()
@@ -116,13 +116,13 @@ def check_read(path, factor):
     check_read_size(path, factor * os.path.getsize(path), have)
 
 
-def check_read_size(what, need, have):
+def check_read_size(what: str | os.PathLike, need: float, have: int | None) -> None:
     """Refuse reading ``what`` when ``need`` bytes of memory exceed ``have`` (None: unknown)."""
     if have is not None and need > have:
         _refuse(f"{what}: reading it", need, have)
 
 
-def check_solve(path, n_vertices):
+def check_solve(path: str, n_vertices: int) -> None:
     """Before solving: refuse a mesh whose solve would not fit."""
     have = available_memory()
     need = SOLVE_BYTES_PER_VERTEX * n_vertices

@@ -1,5 +1,6 @@
 """Outputs must never land on inputs: the same file, however it is named."""
 import os
+from collections.abc import Sequence
 
 from .errors import InputError
 
@@ -14,7 +15,7 @@ def _identity(path):
     return real, (st.st_dev, st.st_ino)
 
 
-def refuse_overwriting_inputs(outputs, inputs):
+def refuse_overwriting_inputs(outputs: Sequence[str], inputs: Sequence[tuple[str, str]]) -> None:
     """Raise :class:`InputError` when any of ``outputs`` is one of ``inputs``: the same real
     path (``./in.obj``, an absolute path, a symbolic link) or the same file (a hard link).
 
@@ -31,7 +32,8 @@ def refuse_overwriting_inputs(outputs, inputs):
     ...
     srarap_cli.runtime.errors.InputError: ./in.obj: is the mesh (in.obj); refusing to overwrite an input
     """
-    by_path, by_file = {}, {}
+    by_path: dict[str, tuple[str, str]] = {}
+    by_file: dict[tuple[int, int], tuple[str, str]] = {}
     for what, path in inputs:
         real, key = _identity(path)
         by_path.setdefault(real, (what, path))

@@ -14,6 +14,8 @@ import os
 import signal
 import sys
 import threading
+from collections.abc import Callable, Iterator
+from typing import NoReturn
 
 from . import streams
 
@@ -38,14 +40,14 @@ def _on_signal(signum, _frame):
     raise Terminated()
 
 
-def own():
+def own() -> None:
     """Take the signals for the ``srarap`` process (the console entry calls this first)."""
     global OWNED
     OWNED = True
     install()
 
 
-def install():
+def install() -> None:
     """Route SIGINT and SIGTERM to exceptions (main thread only: signals go there)."""
     if threading.current_thread() is threading.main_thread():
         for signum in SIGNALS:
@@ -53,7 +55,7 @@ def install():
 
 
 @contextlib.contextmanager
-def deferred():
+def deferred() -> Iterator[None]:
     """Hold SIGINT/SIGTERM back inside the block; one that arrived is raised after it."""
     blocked = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
     try:
@@ -62,20 +64,20 @@ def deferred():
         signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
 
-def block():
+def block() -> None:
     """Hold SIGINT/SIGTERM back from now on (the ``srarap`` process is on its way out; in a
     process that hosts srarap as a library, nothing changes)."""
     if OWNED:
         signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
 
 
-def pending():
+def pending() -> signal.Signals | int:
     """The signal that arrived or is waiting (held back), or 0."""
     waiting = [s for s in SIGNALS if s in signal.sigpending()]
     return RECEIVED or (waiting[0] if waiting else 0)
 
 
-def exit_now(code, report=None):
+def exit_now(code: int, report: Callable[[str], str] | None = None) -> NoReturn:
     """End the process with ``code``: signals blocked, streams flushed, no teardown.
 
     A signal that arrived (even one swallowed on the way) or waits turns the code into 130 or
@@ -88,9 +90,9 @@ def exit_now(code, report=None):
     _flush(sys.stderr)
     signum = pending()  # the last look: from here to the exit takes microseconds
     if signum and code not in CODES.values():
-        code = CODES[signum]
+        code = CODES[signal.Signals(signum)]
         if report is not None:
-            _write(sys.stderr, f"srarap: error: {report(WORDS[signum])}\n")
+            _write(sys.stderr, f"srarap: error: {report(WORDS[signal.Signals(signum)])}\n")
             _flush(sys.stderr)
     os._exit(code)
 

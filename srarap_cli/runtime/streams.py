@@ -10,13 +10,14 @@ import contextlib
 import os
 import tempfile
 import threading
+from collections.abc import Iterator
 
 _lock = threading.Lock()
-_held = {}  # token -> (saved descriptor, temporary file); at most one active at a time
+_held: dict[object, tuple] = {}  # token -> (saved descriptor, temporary file); at most one active at a time
 
 
 @contextlib.contextmanager
-def held_c_stderr():
+def held_c_stderr() -> Iterator[None]:
     """Hold back what C code writes to descriptor 2 inside the block: written out after it
     when the block succeeds, dropped when it raises (srarap then reports the failure in its
     own line). A block entered while another holds passes through."""
@@ -40,7 +41,7 @@ def held_c_stderr():
             _end(token, keep=ok)
 
 
-def release():
+def release() -> None:
     """Put descriptor 2 back now, dropping what was held (called before an error line)."""
     with _lock:
         tokens = list(_held)

@@ -13,11 +13,15 @@ which do not share data, so the results stay the same bit for bit).
 import functools
 import os
 import threading
+from collections.abc import Callable
+from typing import TypeVar
+
+T = TypeVar("T")
 
 _VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 
-def single_threaded(func):
+def single_threaded(func: Callable) -> Callable:
     """Run ``func`` with every BLAS library limited to one thread (threadpoolctl)."""
 
     @functools.wraps(func)
@@ -30,7 +34,7 @@ def single_threaded(func):
     return wrapper
 
 
-def pin_process():
+def pin_process() -> None:
     """Ask the BLAS libraries for one thread before they load (the command line calls this
     first; libraries already loaded keep their pools, which :func:`single_threaded` limits),
     and keep threads in the main malloc arena under an address-space limit."""
@@ -60,7 +64,7 @@ def _one_arena_under_address_limit():
         pass
 
 
-def background(func):
+def background(func: Callable[[], T]) -> Callable[[], T]:
     """Start ``func()`` in a daemon thread; returns ``wait()``, which gives its result or
     raises its exception.
 

@@ -14,6 +14,7 @@ by a matrix-to-quaternion conversion. Column 0 serves every rotation short of ab
 degrees; other cells take the column of the reference rotor's largest component, and cells
 where no column is reliable (near-ambiguous, rank-1 or zero ``S``) go to ``numpy.linalg.eigh``.
 """
+
 import numpy as np
 
 from .quaternion import PRODUCT_BASIS, align_hemisphere
@@ -29,7 +30,7 @@ _MIN_WEIGHT = 0.05
 _MIN_GAP = 1e-9
 
 
-def closest_rotors(S, reference):
+def closest_rotors(S: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """Unit quaternions of the rotations closest to ``S``, on ``reference``'s hemisphere.
 
     Parameters

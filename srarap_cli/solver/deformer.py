@@ -131,12 +131,20 @@ class Deformer:
     constrained : (k,) int array, ids of vertices whose positions are prescribed
     settings : Settings, optional, every solver setting at once (default: the defaults);
         the solve settings in it are what :meth:`solve` uses unless told otherwise
-    **options : setup and solve settings by name, over ``settings`` (as below; see
-        :mod:`srarap_cli.solver.settings`)
+    **options : setup and solve settings by name, over ``settings`` (the setup ones below;
+        see :mod:`srarap_cli.solver.settings`)
+    area : float, optional; ``A`` in the energy, default the surface area of (V, F)
+    labels : (k,) int array, optional, handle group of each constrained vertex (the
+        rotation-aware start fits one rotation per group); default: the connected patches
+        the constrained vertices form
+    prepare : bool, factor and build the local step now (False: on first use, for a
+        multiresolution solver that may only need the fine mesh's energy)
+
+    Other Parameters
+    ----------------
     alpha : float > 0, bending weight (energy uses ``alpha * area``)
     feedback : float >= 0, pull of each rotor toward its previous value (paper's eps)
     weights : {"cotan-clamped", "cotan", "uniform"}
-    area : float, optional; ``A`` in the energy, default the surface area of (V, F)
     method : {"sr-linear-sym", "sr-linear", "sr-relax", "arap"}
         Local step: the symmetric total-energy variant of the paper's one-solve system (the
         default: fastest to a given energy on the benchmarks), the paper's system itself,
@@ -155,11 +163,6 @@ class Deformer:
         converged shapes of the benchmark cases by at most 1e-5 of the bounding-box diagonal.
         With ``feedback = 0`` the rule is ``lagged`` (a handle without a boundary, a whole
         constrained part, would have no right-hand side).
-    labels : (k,) int array, optional, handle group of each constrained vertex (the
-        rotation-aware start fits one rotation per group); default: the connected patches
-        the constrained vertices form
-    prepare : bool, factor and build the local step now (False: on first use, for a
-        multiresolution solver that may only need the fine mesh's energy)
 
     Attributes
     ----------
@@ -287,7 +290,7 @@ class Deformer:
                                     self.edges.stretch(P) if self.local_step.needs_stretch
                                     else None, R_prev)
 
-    def step_for(self, targets: ArrayLike, tol: float | None = None) -> "LocalGlobalStep":
+    def step_for(self, targets: np.ndarray, tol: float | None = None) -> "LocalGlobalStep":
         """The :class:`~srarap_cli.solver.step.LocalGlobalStep` of one set of targets
         (``tol``: default the solver's setting)."""
         return LocalGlobalStep(self, targets, self.settings.tol if tol is None else tol)
@@ -345,10 +348,10 @@ class Deformer:
         if initial is not None and start not in WARM_STARTS:
             start = "warm"
         first = STARTS[start](step, initial)
-        if not callable(driver):
-            driver = DRIVERS[driver or ACCEL_DRIVERS[s.accel]]
-        state = driver(step, first, monitor)
-        return DeformResult(state.positions, state.rotors, monitor.log, monitor.reason,
+        run = driver if callable(driver) else DRIVERS[driver or ACCEL_DRIVERS[s.accel]]
+        state = run(step, first, monitor)
+        reason = monitor.reason or StopReason.DRIVER
+        return DeformResult(state.positions, state.rotors, monitor.log, reason,
                             monitor.iterations, monitor.detail)
 
 

@@ -7,12 +7,14 @@
 surface area, ``deg_i`` the number of neighbours. The ``min`` makes the bending term blind to
 the sign of a quaternion (``q`` and ``-q`` are the same rotation).
 """
+
 import numpy as np
 
+from .operators import CellGraph
 from .quaternion import rotate
 
 
-def membrane_energy(graph, rest_edges, P, R):
+def membrane_energy(graph: CellGraph, rest_edges: np.ndarray, P: np.ndarray, R: np.ndarray) -> float:
     """``sum_i sum_j c_ij |R_i q_ij R_i~ - p_ij|^2``, from per-edge residuals.
 
     Parameters
@@ -31,7 +33,7 @@ def membrane_energy(graph, rest_edges, P, R):
     return float(graph.c @ np.einsum("ij,ij->i", residual, residual))
 
 
-def membrane_from_covariance(S, stretch_total, Rm):
+def membrane_from_covariance(S: np.ndarray, stretch_total: float, Rm: np.ndarray) -> float:
     """The membrane energy from cell covariances: ``sum_i s_i - 2 trace(R_i^T S_i)``.
 
     Exact algebra (``|Rq - p|^2 = |q|^2 + |p|^2 - 2 p.Rq``), nearly free once ``S`` and
@@ -47,14 +49,14 @@ def membrane_from_covariance(S, stretch_total, Rm):
     return float(stretch_total - 2.0 * np.einsum("nab,nab->", Rm, S))
 
 
-def accurate_enough(value, scale, tol):
+def accurate_enough(value: float, scale: float, tol: float) -> bool:
     """Whether a cancelling evaluation of size ``value`` (rounding ~1e-16 * ``scale``) is
     accurate to 1% of the relative tolerance ``tol`` the caller will test it against.
     (``value`` is negative only when negative cotangent weights make the energy unbounded.)"""
     return tol > 0 and abs(value) * tol >= 1e-14 * scale
 
 
-def bending_energy(graph, R, alpha, area):
+def bending_energy(graph: CellGraph, R: np.ndarray, alpha: float, area: float) -> float:
     """``alpha * area * sum_i sum_j min(|R_i - R_j|^2, |R_i + R_j|^2) / deg_i``.
 
     ``area`` is passed, not read from ``graph``, so that a solve restricted to a region of

@@ -1,8 +1,11 @@
 """Global step: positions from rotors by a Poisson solve, factored once (paper section 5)."""
+from collections.abc import Callable
+
 import numpy as np
 import scipy.sparse as sp
 
 from .linalg import factor
+from .operators import CellGraph
 
 
 class PoissonSolver:
@@ -19,7 +22,7 @@ class PoissonSolver:
     constrained : (n,) bool array
     """
 
-    def __init__(self, graph, constrained):
+    def __init__(self, graph: CellGraph, constrained: np.ndarray) -> None:
         self.fixed = np.flatnonzero(constrained)
         K = graph.laplacian
         free = ~constrained
@@ -34,7 +37,7 @@ class PoissonSolver:
         self._to_fixed = K[:, self.fixed].tocsr()
         self._free_column = free.astype(float)[:, None]
 
-    def bind(self, targets):
+    def bind(self, targets: np.ndarray) -> Callable:
         """The solve for one set of constrained positions, reused for many right-hand sides.
 
         Parameters

@@ -1,11 +1,13 @@
 """The rotation each handle group undergoes, from its rest and target positions."""
+
 import numpy as np
-from scipy.sparse import csgraph
+from scipy.sparse import csgraph, csr_matrix
 
 from .quaternion import from_matrix
 
 
-def group_rotors(rest, targets, labels, n_groups):
+def group_rotors(rest: np.ndarray, targets: np.ndarray, labels: np.ndarray, n_groups: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
     """The rotation each handle group undergoes, as a rotor per constrained vertex.
 
     Least-squares rotation (Kabsch) from each group's rest points to its targets: exact for
@@ -49,13 +51,13 @@ def group_rotors(rest, targets, labels, n_groups):
     return from_matrix(rot)[labels], determined[labels]
 
 
-def label_sum(values, labels, n_groups):
+def label_sum(values: np.ndarray, labels: np.ndarray, n_groups: int) -> np.ndarray:
     """Per-label sums of the rows of ``values`` (k, c): (n_groups, c)."""
     return np.stack([np.bincount(labels, weights=values[:, c], minlength=n_groups)
                      for c in range(values.shape[1])], axis=1)
 
 
-def connected_groups(adjacency, ids):
+def connected_groups(adjacency: csr_matrix, ids: np.ndarray) -> np.ndarray:
     """Handle groups when none are given: the connected patches the vertices ``ids`` form
     on the mesh (edges between two of them).
 

@@ -25,7 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .group_rotations import label_sum
+from .operators import CellGraph
 from .quaternion import rotate, to_matrix
+from .rest_edges import RestEdges
 
 
 @dataclass
@@ -89,7 +91,8 @@ class EnergyHessian:
         return label_sum(rows.T, labels, self.n)
 
 
-def energy_hessian(graph, edges, P, R, bending_weight):
+def energy_hessian(graph: CellGraph, edges: RestEdges, P: np.ndarray, R: np.ndarray, bending_weight: float
+                   ) -> EnergyHessian:
     """Half the Hessian of the SR-ARAP energy at positions ``P`` and rotors ``R``.
 
     The membrane blocks are per-cell sums, formed from per-cell moments instead of per

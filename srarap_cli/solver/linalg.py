@@ -1,9 +1,11 @@
 """Sparse factorizations shared by the Poisson solve and the rotor systems' preconditioner."""
 import contextlib
+from collections.abc import Callable
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.sparse import csr_matrix
 
 from ..runtime.errors import SingularSystemError
 from ..runtime.forked import run_forked
@@ -42,7 +44,8 @@ def _warm_blas():
 _warm_blas()
 
 
-def factor(A, symmetric, order=None, approximate=False):
+def factor(A: csr_matrix, symmetric: bool, order: Callable | None = None, approximate: bool = False
+           ) -> Callable:
     """LU-factor a sparse square matrix; returns a callable ``solve(b)``.
 
     A symmetric matrix gets a symmetric fill-reducing ordering, which roughly halves the
@@ -145,7 +148,7 @@ def _flushed(single):
     return subnormals_flushed() if single else contextlib.nullcontext()
 
 
-def fill_order(A):
+def fill_order(A: csr_matrix) -> np.ndarray:
     """METIS nested dissection order of the graph of a symmetric sparse matrix's stored
     off-diagonal entries (explicit zeros count); vertices without any come first.
 
@@ -174,7 +177,7 @@ def fill_order(A):
     adjacency = pymetis.CSRAdjacency(sub.indptr, sub.indices)
     # the child gets the function itself: no import statement runs after the fork
     found = run_forked(_dissection_bytes, pymetis.nested_dissection, adjacency)
-    order = (np.frombuffer(found, dtype="<i8") if _is_permutation(found, ids.size)
+    order = (np.frombuffer(found, dtype="<i8") if found is not None and _is_permutation(found, ids.size)
              else _dissection(pymetis.nested_dissection, adjacency))
     return np.concatenate([np.flatnonzero(~linked), ids[order]])
 

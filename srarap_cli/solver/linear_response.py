@@ -25,6 +25,7 @@ import scipy.sparse.linalg as spla
 from .hessian import energy_hessian
 from .linalg import factor
 from .local_step.linear_sym import symmetric_weights
+from .precomputed import Precomputed
 
 #: relative residual of the rotors' system: the prediction's error is then about 1% of the
 #: first-order change, far below the second-order error it leaves anyway
@@ -44,7 +45,7 @@ class LinearResponse:
     deformer : Deformer
     """
 
-    def __init__(self, deformer):
+    def __init__(self, deformer: Precomputed) -> None:
         self.deformer = deformer
         graph = deformer.graph
         # the bending pairs as the total-energy rotor system couples them (1/deg_i + 1/deg_j)
@@ -57,7 +58,7 @@ class LinearResponse:
         self._precondition = factor(M, symmetric=True, order=graph.fill_order,
                                     approximate=True)
 
-    def rotations(self, P, R, moved):
+    def rotations(self, P: np.ndarray, R: np.ndarray, moved: np.ndarray) -> np.ndarray | None:
         """Rotor increments ``w`` (n, 3), rotation vectors turning each rotor to
         ``exp(w / 2) R``, that follow the held vertices' move ``moved`` to first order from
         the state ``(P, R)``; None when the system gave no finite answer.

@@ -1,6 +1,8 @@
 """Mesh problems the solve survives, reported as warnings with counts."""
+
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from .libigl import igl
@@ -9,12 +11,12 @@ from .operators import triangle_normals
 NEEDLE_DEGREES = 1.0
 
 
-def solvable_faces(F):
+def solvable_faces(F: np.ndarray) -> np.ndarray:
     """Triangles without a repeated vertex (those have no area and no edge to speak of)."""
     return F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
 
 
-def geometry_problem(V, F):
+def geometry_problem(V: np.ndarray, F: np.ndarray) -> str | None:
     """Why the triangles F of V cannot be solved in double precision, or None.
 
     Examples
@@ -37,7 +39,7 @@ def geometry_problem(V, F):
     return None
 
 
-def unique_rows(a):
+def unique_rows(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Distinct rows of an int array (m, k) in lexicographic order, and how often each occurs.
 
     Same result as ``np.unique(a, axis=0, return_counts=True)``, several times faster on
@@ -57,7 +59,7 @@ def unique_rows(a):
     return s[start], np.diff(np.append(start, len(s)))
 
 
-def edge_adjacency(F, n):
+def edge_adjacency(F: np.ndarray, n: int) -> csr_matrix:
     """(n, n) sparse matrix with every edge of ``F`` (f, 3) in one direction at least, for
     undirected graph algorithms (``csgraph`` with ``directed=False``): half the entries of
     the symmetric matrix (2.5M faces: built and its components found in 0.27 s, not 0.49).
@@ -73,7 +75,7 @@ def edge_adjacency(F, n):
     return sp.csr_matrix((np.ones(F.size), (F.ravel(), F[:, [1, 2, 0]].ravel())), shape=(n, n))
 
 
-def edge_counts(F):
+def edge_counts(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Undirected edges (e, 2) of triangles F (sorted pairs, in lexicographic order) and how
     many triangles hold each.
 
@@ -95,7 +97,7 @@ def edge_counts(F):
     return np.stack([low, A.indices.astype(np.int64)], axis=1), A.data
 
 
-def mesh_warnings(V, F):
+def mesh_warnings(V: np.ndarray, F: np.ndarray) -> list[str]:
     """Warning lines for duplicate faces, collapsed, zero-area and needle triangles,
     non-manifold edges and vertices, and surfaces cut open at coincident vertices, of a
     triangle mesh (V (n, 3), F (f, 3)).
@@ -160,7 +162,7 @@ def _manifold_warnings(F, n, counts):
     return out
 
 
-def fans_per_vertex(F, n):
+def fans_per_vertex(F: np.ndarray, n: int) -> np.ndarray:
     """How many fans the faces around each vertex form: groups of faces joined through the
     edges at the vertex. A vertex is manifold (libigl's ``is_vertex_manifold``) when the
     count is one; this count takes one sparse matrix and one connected-components pass, four

@@ -7,7 +7,8 @@ from numpy.typing import ArrayLike
 
 from .deformer import Deformer, DeformResult
 from .interface import Solver
-from .multires import MultiresDeformer, coarse_size
+from .multires.deformer import MultiresDeformer
+from .multires.size import coarse_size
 from .settings import Settings, with_keywords
 
 

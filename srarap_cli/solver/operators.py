@@ -50,7 +50,7 @@ class CellGraph:
     degenerate: int = 0
 
     @property
-    def n(self):
+    def n(self) -> int:
         return self.degree.shape[0]
 
     @cached_property
@@ -62,7 +62,7 @@ class CellGraph:
         edges = sp.csr_matrix((np.ones(self.I.size), (self.I, self.J)), shape=(self.n,) * 2)
         return fill_order(edges)
 
-    def fill_order(self, rows=None):
+    def fill_order(self, rows: np.ndarray | None = None) -> np.ndarray:
         """A fill-reducing order of the vertices ``rows`` (default all), as positions into
         ``rows``: METIS's nested dissection of the whole mesh graph, run once per graph and
         restricted to each matrix's vertices, so the Poisson matrix and the rotor
@@ -75,13 +75,13 @@ class CellGraph:
         rank[order] = np.arange(self.n)
         return np.argsort(rank[rows], kind="stable")
 
-    def edge_blocks(self, m=None):
+    def edge_blocks(self, m: int | None = None) -> list[slice]:
         """Slices of at most :data:`EDGE_BLOCK` consecutive edges that cover the first ``m``
         (default all) edges."""
         m = self.I.size if m is None else m
         return [slice(a, min(a + EDGE_BLOCK, m)) for a in range(0, m, EDGE_BLOCK)]
 
-    def cell_sum(self, values, edges=slice(None)):
+    def cell_sum(self, values: np.ndarray, edges: slice = slice(None)) -> np.ndarray:
         """Sum per-edge ``values`` of shape (m, ...) into their source vertex: (n, ...);
         ``edges`` (a slice) says which edges ``values`` belong to (default all)."""
         flat = values.reshape(values.shape[0], -1)
@@ -91,12 +91,12 @@ class CellGraph:
         return sums.reshape((self.n,) + values.shape[1:])
 
 
-def mesh_area(V, F):
+def mesh_area(V: np.ndarray, F: np.ndarray) -> float:
     """Total surface area of a triangle mesh (zero-area faces count 0)."""
     return float(np.nansum(igl.doublearea(V, F)) / 2.0)
 
 
-def cell_graph(V, F, weights="cotan-clamped"):
+def cell_graph(V: np.ndarray, F: np.ndarray, weights: str = "cotan-clamped") -> CellGraph:
     """Build the cell graph of a triangle mesh.
 
     Parameters
@@ -144,7 +144,7 @@ def cell_graph(V, F, weights="cotan-clamped"):
                      degenerate=int((~finite).sum()))
 
 
-def triangle_normals(V, F):
+def triangle_normals(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     """Unnormalized normals of triangles ``F`` (t, 3) of ``V`` (n, 3): ``(b - a) x (c - a)``,
     twice each triangle's area long: (t, 3). Rows gathered with ``np.take`` and the cross
     product written out (``np.cross`` copies its inputs around): the same values, several

@@ -26,7 +26,8 @@ class Submesh:
     which: np.ndarray
 
 
-def restrict(V, F, ids, targets, region):
+def restrict(V: np.ndarray, F: np.ndarray, ids: np.ndarray, targets: np.ndarray, region: np.ndarray
+             ) -> Submesh:
     """Cut out the triangles touching movable vertices (region minus constrained).
 
     Vertices of those triangles outside the region are held at rest, as CGAL's region of

@@ -22,12 +22,12 @@ class State:
     positions: np.ndarray
     rotors: np.ndarray
     covariances: np.ndarray
-    stretch: np.ndarray
+    stretch: np.ndarray | None
     stretch_total: float
     membrane: float
     bending: float
     iteration: int = 0
 
     @property
-    def total(self):
+    def total(self) -> float:
         return self.membrane + self.bending

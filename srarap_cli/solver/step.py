@@ -1,7 +1,9 @@
 """One local/global iteration (paper sections 5-6) for one set of targets: state -> state."""
+
 import numpy as np
 
 from .energy import accurate_enough, membrane_energy, membrane_from_covariance
+from .precomputed import Precomputed
 from .quaternion import to_matrix
 from .state import State
 
@@ -15,7 +17,7 @@ from .state import State
 MAX_FORCING = 1e-3
 
 
-def local_forcing(tol):
+def local_forcing(tol: float) -> float:
     """The local step's forcing for a solve to ``tol``."""
     return min(MAX_FORCING, float(np.sqrt(max(tol, 0.0))))
 
@@ -34,7 +36,7 @@ class LocalGlobalStep:
     tol : float, the stopping tolerance: energies are evaluated accurately enough for it
     """
 
-    def __init__(self, deformer, targets, tol):
+    def __init__(self, deformer: Precomputed, targets: np.ndarray, tol: float) -> None:
         self.deformer = deformer
         self.tol = tol
         self.forcing = local_forcing(tol)
@@ -42,22 +44,23 @@ class LocalGlobalStep:
         self.fixed_targets = deformer.fixed_targets(self.targets)
         self._poisson = deformer.poisson.bind(self.fixed_targets)
 
-    def __call__(self, state):
+    def __call__(self, state: State) -> State:
         R = self.local(state)
         Rm = to_matrix(R)
         return self.state(self.positions(R, Rm), R, Rm, state.iteration + 1)
 
-    def local(self, state):
+    def local(self, state: State) -> np.ndarray:
         """Local step: new rotors (n, 4) for the state's positions (its rotors are the
         previous ones: feedback, constrained rotors, hemispheres)."""
         return self.deformer.local_step.step(state.covariances, state.stretch, state.rotors,
                                              self.forcing)
 
-    def positions(self, R, Rm=None):
+    def positions(self, R: np.ndarray, Rm: np.ndarray | None = None) -> np.ndarray:
         """Global step: the positions (n, 3) that best fit rotors ``R`` (n, 4)."""
         return self._poisson(self.deformer.edges.rotated_divergence(R, Rm))
 
-    def state(self, P, R, Rm=None, iteration=0, energy=True):
+    def state(self, P: np.ndarray, R: np.ndarray, Rm: np.ndarray | None = None, iteration: int = 0,
+              energy: bool = True) -> State:
         """The :class:`State` of positions ``P`` with rotors ``R``; ``energy=False`` leaves
         the energy terms NaN (a driver that only needs the covariances)."""
         d = self.deformer
@@ -72,7 +75,7 @@ class LocalGlobalStep:
         return self._evaluate(P, R, to_matrix(R) if Rm is None else Rm, S, s, stretch_total,
                               iteration)
 
-    def with_rotors(self, state, R, iteration=None):
+    def with_rotors(self, state: State, R: np.ndarray, iteration: int | None = None) -> State:
         """The state's positions with other rotors ``R``: covariances reused, energy anew."""
         return self._evaluate(state.positions, R, to_matrix(R), state.covariances,
                               state.stretch, state.stretch_total,

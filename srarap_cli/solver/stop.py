@@ -13,6 +13,8 @@ class StopReason(StrEnum):
     paper's multiresolution transfer, never iterated at full resolution (its coarse solve
     has a reason of its own). ``non-finite``: the energy became NaN or infinite (the solve
     raises :class:`~srarap_cli.runtime.errors.NumericalError`; a batch records the reason).
+    ``stopped by driver``: a driver of one's own (``solve(driver=...)``) returned before the
+    monitor's tests asked it to.
 
     Examples
     --------
@@ -26,6 +28,7 @@ class StopReason(StrEnum):
     TIME_LIMIT = "time limit"
     TRANSFER = "transfer"
     NON_FINITE = "non-finite"
+    DRIVER = "stopped by driver"
 
     @property
     def complete(self) -> bool:

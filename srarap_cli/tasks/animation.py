@@ -14,13 +14,19 @@ import io
 import json
 import time
 import zipfile
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
+from ..io.handles import Constraints
 from ..io.input_files import read_input_bytes
+from ..io.mesh.mesh import Mesh
 from ..runtime.errors import InputError, excerpt
+from ..solver.deformer import DeformResult
 from ..solver.quaternion import align_hemisphere, multiply, normalize
+from ..solver.settings import Settings
 from .pipeline import command_solver, problem, scatter
 
 FRAME_FIELDS = ("frame", "iterations", "membrane", "bending", "total", "converged",
@@ -40,7 +46,7 @@ class FrameState:
     #: extrapolates from both
     before: tuple = (np.zeros((0, 3)), np.zeros((0, 4)))
 
-    def to_bytes(self):
+    def to_bytes(self) -> bytes:
         buf = io.BytesIO()
         np.savez(buf, frame=self.frame, positions=self.positions, rotors=self.rotors,
                  rows=json.dumps(self.rows), fingerprint=self.fingerprint,
@@ -48,7 +54,7 @@ class FrameState:
         return buf.getvalue()
 
     @classmethod
-    def from_file(cls, path):
+    def from_file(cls, path: str) -> "FrameState":
         try:
             with np.load(path) as z:
                 return cls(int(z["frame"]), z["positions"], z["rotors"],
@@ -71,16 +77,19 @@ class Animator:
     name : str, the mesh's file, for error messages
     """
 
-    def __init__(self, mesh, constraints, opts, cache=None, name="mesh"):
+    def __init__(self, mesh: Mesh, constraints: Constraints, opts: Settings, cache: str | None = None,
+                 name: str = "mesh") -> None:
         self.mesh = mesh
         self.constraints = constraints
         self.problem = problem(mesh, constraints, name)
         #: warnings: what the mesh checks and the solver found (e.g. mesh problems)
         self.deformer, self.warnings = command_solver(mesh, self.problem, opts, cache)
-        self.last_result = None
+        self.last_result: DeformResult | None = None
 
-    def run(self, frames, *, max_iter=None, stop_unconverged=False, state=None,
-            on_frame=None, fingerprint=""):
+    def run(self, frames: int, *, max_iter: int | None = None, stop_unconverged: bool = False,
+            state: FrameState | None = None,
+            on_frame: Callable[[int, np.ndarray, FrameState], None] | None = None,
+            fingerprint: str = "") -> FrameState | None:
         """Solve frames ``state.frame + 1`` (or 0) to ``frames - 1``, each with the solve
         settings the Animator was built with (``tol``, ``max_iter``, ``time_limit``,
         ``accel``, ``start``: the limits hold per frame); ``max_iter`` replaces the setting
@@ -102,7 +111,7 @@ class Animator:
             start = time.perf_counter()
             frame_targets = self.constraints.targets_at(float(f))
             targets = self.problem.targets_for(frame_targets)
-            options = {}
+            options: dict[str, Any] = {}
             if P is not None:
                 # the carried frames follow the targets to first order already
                 options.update(start="extrapolated", initial=_carried(P, R, before))
@@ -143,7 +152,7 @@ def _carried(P, R, before):
 _CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
 
 
-def fingerprint(paths, opts, *extra):
+def fingerprint(paths: Sequence[str], opts: Settings, *extra: Any) -> str:
     """Content hash of the files ``paths``, the resolved settings and anything else that
     decides the frames (``extra``, JSON-serializable): a resume state belongs to one run."""
     h = hashlib.sha256()

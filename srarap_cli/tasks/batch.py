@@ -24,6 +24,7 @@ import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from importlib import metadata
+from typing import Any
 
 from ..io.documents import load_document
 from ..io.handles import load_handles, referenced_files
@@ -41,11 +42,15 @@ from .pipeline import deform_mesh
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
 #: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason` (empty for a job that
 #: never reached the solver)
+#: a job of a manifest: name, absolute paths, output, settings, expect
+Job = dict[str, Any]
+#: a job's summary row (keys SUMMARY_FIELDS)
+Row = dict[str, Any]
 SUMMARY_FIELDS = ("job", "status", "stop", "iterations", "energy", "seconds", "compare_max",
                   "message")
 
 
-def load_manifest(path):
+def load_manifest(path: str) -> list[Job]:
     """Jobs of a manifest, with absolute paths and merged settings (list of dict)."""
     doc = load_document(path, "json" if path.lower().endswith(".json") else "yaml")
     if not isinstance(doc, dict) or not isinstance(doc.get("jobs"), list) or not doc["jobs"]:
@@ -101,7 +106,8 @@ def _output_name(where, value):
     return norm
 
 
-def check_outputs(jobs, out_dir, manifest):
+def check_outputs(jobs: list[Job],
+                  out_dir: str, manifest: str) -> None:
     """Refuse a run whose outputs (or their sidecars) would land on any job's input or the
     manifest: a batch must never overwrite what it reads."""
     inputs = [("manifest", manifest)]
@@ -122,7 +128,7 @@ def _settings(where, key, spec):
     return parse_mapping(spec, key, lambda message: InputError(f"{where}: {message}"))
 
 
-def fingerprint(job):
+def fingerprint(job: Job) -> str:
     """Content hash of everything that decides a job's output."""
     h = hashlib.sha256()
     for path in (job["mesh"], job["handles"], *referenced_files(job["handles"])):
@@ -135,7 +141,8 @@ def fingerprint(job):
     return h.hexdigest()
 
 
-def run_job(job, out_dir, keep_unconverged=False):
+def run_job(job: Job, out_dir: str,
+            keep_unconverged: bool = False) -> Row:
     """Run one job; never raises. Returns its summary row (dict with SUMMARY_FIELDS).
 
     A job that does not converge writes its sidecar (the status, so a rerun reports it without
@@ -210,7 +217,9 @@ def _recorded_row(sidecar):
             "status": rec["status"], "stop": rec.get("stop", "")}
 
 
-def run_batch(jobs, out_dir, workers=1, scheduler=None, keep_unconverged=False):
+def run_batch(jobs: list[Job],
+              out_dir: str, workers: int = 1, scheduler: str | None = None, keep_unconverged: bool = False
+              ) -> list[Row]:
     """Run jobs: on a Dask cluster at ``scheduler``, else in ``workers`` local processes
     (in this process when 1). Rows come back in manifest order. ``keep_unconverged``: see
     :func:`run_job`.

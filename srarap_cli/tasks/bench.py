@@ -6,12 +6,14 @@ same process) minimizes another energy and is compared on iteration cost and fin
 """
 import statistics
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..solver.deformer import Deformer
 from ..solver.libigl import igl
+from ..solver.settings import Settings
 
 ACCELERATED = "+anderson"
 SR_METHODS = ("sr-linear", "sr-linear-sym", "sr-relax", "sr-linear-sym" + ACCELERATED)
@@ -31,7 +33,9 @@ class MethodRun:
     summary: dict = field(default_factory=dict)
 
 
-def run_methods(V, F, ids, targets, methods, *, settings, time_budget):
+def run_methods(V: np.ndarray, F: np.ndarray, ids: np.ndarray, targets: np.ndarray,
+                methods: Sequence[str], *, settings: Settings,
+                time_budget: float) -> list[MethodRun]:
     """Run ``methods`` (names from ALL_METHODS, plus ``libigl-arap``) on one problem.
 
     A plain method name runs the plain iteration from Laplacian editing (the paper's

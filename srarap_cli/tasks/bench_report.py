@@ -1,9 +1,10 @@
 """Files and table of a benchmark: curves CSV, summary JSON, energy-vs-time PNG."""
 import io
 import json
+from typing import Any
 
 from ..io.solve_log import LOG_FIELDS, format_log
-from .bench import IGL, SR_METHODS
+from .bench import IGL, SR_METHODS, MethodRun
 
 COLUMNS = [("method", "method", "{}"), ("iterations", "iters", "{}"),
            ("ms_per_iteration", "ms/iter", "{:.2f}"), ("iterations_to_1%", "it@1%", "{}"),
@@ -13,16 +14,16 @@ COLUMNS = [("method", "method", "{}"), ("iterations", "iters", "{}"),
            ("precompute_s", "precompute s", "{:.3f}")]
 
 
-def curves_csv(runs):
+def curves_csv(runs: list[MethodRun]) -> str:
     rows = [{"method": r.name, **row} for r in runs for row in r.log]
     return format_log(rows, ".csv", ("method",) + LOG_FIELDS)
 
 
-def summary_json(runs, info):
+def summary_json(runs: list[MethodRun], info: dict[str, Any]) -> str:
     return json.dumps({"problem": info, "methods": [r.summary for r in runs]}, indent=2) + "\n"
 
 
-def table(runs):
+def table(runs: list[MethodRun]) -> str:
     """A fixed-width text table, one row per method, plus the libigl comparison."""
     rows = [[h for _, h, _ in COLUMNS]]
     for r in runs:
@@ -41,7 +42,7 @@ def table(runs):
     return "\n".join(lines) + "\n"
 
 
-def plot_png(runs, title):
+def plot_png(runs: list[MethodRun], title: str) -> bytes:
     """PNG bytes: SR energy minus the best against time (log-log), and classic ARAP."""
     import matplotlib
     matplotlib.use("Agg")

@@ -1,16 +1,20 @@
 """How far apart two meshes are: per vertex when they share topology, else by surfaces."""
+
+from typing import Any
+
 import numpy as np
 
+from ..io.mesh.mesh import Mesh
 from ..solver.libigl import igl
 
 
-def same_topology(a, b):
+def same_topology(a: Mesh, b: Mesh) -> bool:
     """Same vertex count and the same polygons in the same order."""
     return (len(a.vertices) == len(b.vertices) and np.array_equal(a.face_sizes, b.face_sizes)
             and np.array_equal(a.face_vertices, b.face_vertices))
 
 
-def compare_meshes(a, b):
+def compare_meshes(a: Mesh, b: Mesh) -> dict[str, Any]:
     """Distances between meshes ``a`` and ``b`` (Mesh), in model units.
 
     Same topology: per-vertex distances ``|a_i - b_i|`` (max, mean, RMS). Otherwise: the

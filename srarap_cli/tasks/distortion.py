@@ -7,7 +7,7 @@ from ..solver.quaternion import IDENTITY, rotate
 from ..solver.rest_edges import RestEdges
 
 
-def vertex_distortion(rest, deformed, F):
+def vertex_distortion(rest: np.ndarray, deformed: np.ndarray, F: np.ndarray) -> np.ndarray:
     """Relative local strain of every vertex cell: ``sqrt(e_i / sum_j c_ij |q_ij|^2)`` where
     ``e_i = min_R sum_j c_ij |R q_ij - p_ij|^2`` (the best-fit rotation's membrane residual).
 

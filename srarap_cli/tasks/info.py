@@ -58,7 +58,7 @@ def handles_info(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> di
             "free": int(len(p.V) - p.ids.size), "of": n}
 
 
-def describe_motion(rest, targets):
+def describe_motion(rest: np.ndarray, targets: np.ndarray) -> str:
     """The rigid motion that best takes ``rest`` (k, 3) to ``targets``, in words.
 
     Examples

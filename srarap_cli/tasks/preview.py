@@ -1,6 +1,10 @@
 """A picture of a deformed mesh: rest and deformed shape, handles coloured or strain mapped."""
+from collections.abc import Sequence
+
 import numpy as np
 
+from ..io.handles import Constraints
+from ..io.mesh.mesh import Mesh
 from .distortion import vertex_distortion
 from .render import face_colors, render_png
 
@@ -16,8 +20,9 @@ UP = {"z": np.eye(3), "-z": np.diag([1.0, -1, -1]),
 CLIP_PERCENTILE = 99
 
 
-def preview_png(mesh, rest=None, constraints=None, color="shade", layout="ghost", view="iso",
-                size=(800, 600), up="y"):
+def preview_png(mesh: Mesh, rest: Mesh | None = None, constraints: Constraints | None = None,
+                color: str = "shade", layout: str = "ghost", view: str | Sequence[str] = "iso",
+                size: tuple[int, int] = (800, 600), up: str = "y") -> bytes:
     """PNG bytes of ``mesh`` (and its ``rest`` shape), handles coloured or distortion mapped;
     ``up`` names the mesh's axis drawn upward (OBJ's convention, y, by default)."""
     turn = UP[up].T
@@ -27,6 +32,8 @@ def preview_png(mesh, rest=None, constraints=None, color="shade", layout="ghost"
     groups = list(constraints.groups.values()) if constraints is not None else None
     colorbar = None
     if color == "distortion":
+        if rest is None:
+            raise ValueError("a distortion map needs the rest shape")
         d = vertex_distortion(rest.vertices, mesh.vertices, F)
         vmax = max(float(np.percentile(d, CLIP_PERCENTILE)), 1e-12)
         colors = face_colors(F, scalar=d, vmax=vmax)

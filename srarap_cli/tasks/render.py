@@ -4,6 +4,8 @@ Triangles are projected, sorted back to front and drawn as one flat 2D polygon c
 Lambert shading, which stays fast on large meshes (no 3D axes).
 """
 import io
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -18,7 +20,7 @@ PALETTE = np.array([[0.90, 0.30, 0.25], [0.20, 0.50, 0.90], [0.25, 0.75, 0.35],
                     [0.95, 0.65, 0.15], [0.60, 0.35, 0.80], [0.10, 0.75, 0.75]])
 
 
-def camera(view):
+def camera(view: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Unit viewing direction and the image's up/right axes for a view name or 'x,y,z'."""
     if view in VIEWS:
         d, up = (np.asarray(v, float) for v in VIEWS[view])
@@ -32,7 +34,7 @@ def camera(view):
     return d, np.cross(right, d), right
 
 
-def face_shading(V, F, d):
+def face_shading(V: np.ndarray, F: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Two-sided Lambert intensity per face, light from the viewer's upper left."""
     n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
@@ -41,7 +43,8 @@ def face_shading(V, F, d):
     return 0.35 + 0.65 * np.abs(n @ light)
 
 
-def draw(ax, V, F, colors, view, alpha=1.0):
+def draw(ax: Any, V: np.ndarray, F: np.ndarray, colors: np.ndarray, view: str,
+         alpha: float = 1.0) -> tuple[float, float, float, float]:
     """Draw one mesh on matplotlib axes ``ax``; returns its 2D bounding box (x0, x1, y0, y1)."""
     from matplotlib.collections import PolyCollection
     d, up, right = camera(view)
@@ -83,7 +86,8 @@ def _triad(fig, left, view, model_axes):
         ax.text(1.15 * x, 1.15 * y, label, color=color, fontsize=7, ha="center", va="center")
 
 
-def face_colors(F, vertex_groups=None, scalar=None, vmax=None):
+def face_colors(F: np.ndarray, vertex_groups: Sequence[np.ndarray] | None = None,
+                scalar: np.ndarray | None = None, vmax: float | None = None) -> np.ndarray:
     """Per-face RGB: base grey, handle groups from the palette, or a viridis scalar."""
     if scalar is not None:
         from matplotlib import colormaps
@@ -98,8 +102,9 @@ def face_colors(F, vertex_groups=None, scalar=None, vmax=None):
     return out
 
 
-def render_png(panels, size=(800, 600), view="iso", colorbar=None, legend=None, axes=None,
-               note=None):
+def render_png(panels: list, size: tuple[int, int] = (800, 600),
+               view: str | Sequence[str] = "iso", colorbar: Any = None,
+               legend: Any = None, axes: Any = None, note: str | None = None) -> bytes:
     """PNG bytes of one or more panels side by side, for one or more views.
 
     Parameters
@@ -130,7 +135,7 @@ def render_png(panels, size=(800, 600), view="iso", colorbar=None, legend=None, 
         boxes, axes = [], []
         for k, meshes in enumerate(panels):
             col = v * len(panels) + k
-            ax = fig.add_axes([col * width / columns, 0, width / columns, 1])
+            ax = fig.add_axes((col * width / columns, 0, width / columns, 1))
             ax.set_axis_off()
             boxes += [draw(ax, V, F, c, name, a) for V, F, c, a in meshes]
             axes.append(ax)
@@ -138,7 +143,7 @@ def render_png(panels, size=(800, 600), view="iso", colorbar=None, legend=None, 
         if triad is not None:
             _triad(fig, v * len(panels) * width / columns, name, triad)
     if colorbar:
-        cax = fig.add_axes([0.895, 0.12, 0.022, 0.76])
+        cax = fig.add_axes((0.895, 0.12, 0.022, 0.76))
         bar = fig.colorbar(ScalarMappable(Normalize(0, colorbar[1]), "viridis"), cax=cax)
         bar.set_label(colorbar[0], fontsize=7, labelpad=2)
         bar.ax.tick_params(labelsize=7)

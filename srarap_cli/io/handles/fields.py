@@ -1,4 +1,7 @@
 """Typed field access for the handle file, with errors that name file, group and field."""
+from collections.abc import Iterable, Sequence
+from typing import Any
+
 import numpy as np
 
 from ...runtime.errors import InputError, excerpt
@@ -10,18 +13,18 @@ MAX_INT = 2 ** 53
 class Context:
     """Where a value sits in the handle file, for one-line error messages."""
 
-    def __init__(self, path, where=""):
+    def __init__(self, path: str, where: str = "") -> None:
         self.path = path
         self.where = where
 
-    def at(self, where):
+    def at(self, where: str) -> "Context":
         return Context(self.path, where)
 
-    def error(self, message):
+    def error(self, message: str) -> InputError:
         prefix = f"{self.path}: {self.where}: " if self.where else f"{self.path}: "
         return InputError(prefix + message)
 
-    def mapping(self, value, name, allowed):
+    def mapping(self, value: Any, name: str, allowed: Iterable[str]) -> dict:
         if not isinstance(value, dict):
             raise self.error(f"{name} must be a mapping of keys to values")
         unknown = sorted(set(map(str, value)) - set(allowed))
@@ -30,7 +33,7 @@ class Context:
                              f"(allowed: {', '.join(sorted(allowed))})")
         return value
 
-    def record(self, value, name, keys):
+    def record(self, value: Any, name: str, keys: Sequence[str]) -> dict:
         """A mapping with exactly ``keys``, all of them required."""
         value = self.mapping(value, name, keys)
         missing = [k for k in keys if k not in value]
@@ -38,13 +41,13 @@ class Context:
             raise self.error(f"{name} needs " + " and ".join(f"{k!r}" for k in keys))
         return value
 
-    def vector(self, value, name, length):
+    def vector(self, value: Any, name: str, length: int) -> np.ndarray:
         arr = self.numbers(value, name)
         if arr.shape != (length,):
             raise self.error(f"{name} must be a list of {length} numbers")
         return arr
 
-    def matrix4(self, value, name):
+    def matrix4(self, value: Any, name: str) -> np.ndarray:
         arr = self.numbers(value, name)
         if arr.size == 16:
             arr = arr.reshape(4, 4)
@@ -52,7 +55,7 @@ class Context:
             raise self.error(f"{name} must be a 4x4 matrix (4 rows of 4 numbers)")
         return arr
 
-    def numbers(self, value, name):
+    def numbers(self, value: Any, name: str) -> np.ndarray:
         if isinstance(value, (str, bool)) or value is None:
             raise self.error(f"{name} must be numeric")
         try:
@@ -63,7 +66,8 @@ class Context:
             raise self.error(f"{name} must be finite")
         return arr
 
-    def number(self, value, name, minimum=None, strict=False):
+    def number(self, value: Any, name: str, minimum: float | None = None,
+               strict: bool = False) -> float:
         arr = self.numbers(value, name)
         if arr.ndim != 0:
             raise self.error(f"{name} must be a single number")
@@ -72,7 +76,7 @@ class Context:
             raise self.error(f"{name} must be {'>' if strict else '>='} {minimum:g}")
         return x
 
-    def integer(self, value, name, minimum=None):
+    def integer(self, value: Any, name: str, minimum: int | None = None) -> int:
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
             raise self.error(f"{name} must be an integer")
         if minimum is not None and value < minimum:

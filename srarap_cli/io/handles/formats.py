@@ -20,7 +20,7 @@ def _numbers(path, dtype):
         raise InputError(f"{path}: non-numeric entry") from None
 
 
-def read_sel(path):
+def read_sel(path: str) -> np.ndarray:
     """Per-vertex status of a ``.sel`` file: (n,) int array, 0 fixed, 1 free, 2 handle."""
     status = _numbers(path, float)
     if status.size == 0 or (status != np.round(status)).any() or ~np.isin(status, (0, 1, 2)).all():
@@ -28,7 +28,7 @@ def read_sel(path):
     return status.astype(np.int64)
 
 
-def read_def(path):
+def read_def(path: str) -> np.ndarray:
     """The 4x4 handle matrix of a ``.def`` file (row-major, applied to column vectors)."""
     values = _numbers(path, float)
     if values.size != 16 or not np.isfinite(values).all():
@@ -40,7 +40,7 @@ def read_def(path):
     return M
 
 
-def read_dmat(path):
+def read_dmat(path: str) -> np.ndarray:
     """A libigl ``.dmat`` column (ASCII ``cols rows`` header, column-major; or binary).
 
     Returns

@@ -32,7 +32,7 @@ class Track:
     pivot: np.ndarray
     easing: str = "linear"
 
-    def transform(self, frame):
+    def transform(self, frame: float) -> tuple[np.ndarray, np.ndarray]:
         """Rotation matrix (3, 3) and translation (3,) at ``frame``."""
         k = int(np.searchsorted(self.frames, frame, side="right")) - 1
         if k < 0:
@@ -45,13 +45,13 @@ class Track:
         q = slerp(self.rotations[k], self.rotations[k + 1], t)
         return to_matrix(q), (1 - t) * self.translations[k] + t * self.translations[k + 1]
 
-    def apply(self, rest, frame):
+    def apply(self, rest: np.ndarray, frame: float) -> np.ndarray:
         """Positions (m, 3) of the group's rest positions ``rest`` at ``frame``."""
         R, t = self.transform(frame)
         return (rest - self.pivot) @ R.T + self.pivot + t
 
 
-def slerp(a, b, t):
+def slerp(a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
     """Spherical interpolation of unit quaternions on the shortest arc.
 
     Examples

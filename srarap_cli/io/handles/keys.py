@@ -2,6 +2,7 @@
 import numpy as np
 
 from ...solver.quaternion import IDENTITY, from_matrix
+from .fields import Context
 from .keyframes import EASINGS, Track
 from .transforms import rotation_matrix
 
@@ -9,7 +10,7 @@ KEY_KEYS = ("frame", "time", "translate", "rotate")
 STATIC_ACTIONS = ("fixed", "translate", "rotate", "matrix")
 
 
-def parse_track(ctx, spec, rest, fps):
+def parse_track(ctx: Context, spec: dict, rest: np.ndarray, fps: float | None) -> Track:
     """Track of a group with ``keyframes`` (rest: (m, 3) rest positions of the group)."""
     clash = [k for k in STATIC_ACTIONS if k in spec]
     if clash:

@@ -3,6 +3,7 @@ import os
 
 import numpy as np
 
+from .fields import Context
 from .formats import SEL_STATUS, read_dmat, read_sel
 
 SELECTOR_KEYS = ("indices", "sphere", "box", "dmat", "sel")
@@ -79,7 +80,7 @@ _SELECTORS = {"indices": _indices, "sphere": _shapes(_sphere), "box": _shapes(_b
               "dmat": _dmat, "sel": _sel}
 
 
-def select(ctx, spec, V, base):
+def select(ctx: Context, spec: dict, V: np.ndarray, base: str) -> np.ndarray:
     """Union of the vertices picked by every selector key present in ``spec``.
 
     Parameters

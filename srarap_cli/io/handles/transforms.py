@@ -5,6 +5,7 @@ import numpy as np
 
 from ...runtime.limits import MAX_COORDINATE
 from ...solver.quaternion import from_axis_angle, to_matrix
+from .fields import Context
 from .formats import read_def
 
 ACTION_KEYS = ("fixed", "translate", "rotate", "pivot", "matrix")
@@ -19,7 +20,7 @@ QUATERNION_KEYS = {"quaternion_wxyz": [0, 1, 2, 3], "quaternion_xyzw": [3, 0, 1,
                    "quaternion": [0, 1, 2, 3]}
 
 
-def rotation_matrix(ctx, spec):
+def rotation_matrix(ctx: Context, spec: dict) -> np.ndarray:
     """3x3 matrix of a ``rotate`` entry: ``axis`` with ``angle_deg``, ``angle_rad`` or
     ``angle`` (degrees), or one of ``quaternion_wxyz``, ``quaternion_xyzw``, ``quaternion``
     (w, x, y, z)."""
@@ -55,7 +56,7 @@ def _matrix(ctx, value, base):
     return M
 
 
-def targets(ctx, spec, rest, base):
+def targets(ctx: Context, spec: dict, rest: np.ndarray, base: str) -> np.ndarray:
     """Target positions (k, 3) of a group whose rest positions are ``rest`` (k, 3).
 
     ``fixed: true`` keeps rest positions; otherwise ``x' = Rot (x - pivot) + pivot +

@@ -4,7 +4,7 @@ import warnings
 import numpy as np
 
 
-def parse_numbers(lines, dtype=float):
+def parse_numbers(lines: list[str], dtype: type = float) -> np.ndarray | None:
     """All numbers of ``lines`` (a list of str) as one flat array, by numpy's C parser (a few
     times faster than Python's split on millions of numbers); None when any token is not a
     number of ``dtype``, for the caller's line-by-line reader to report. A huge integer

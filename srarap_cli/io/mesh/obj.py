@@ -6,6 +6,7 @@ per-corner normals, and libigl's reader keeps no polygons of mixed size or other
 import io
 import re
 import warnings
+from collections.abc import Callable
 
 import numpy as np
 
@@ -40,7 +41,7 @@ def _corner(token, counts, path, lineno):
     return out
 
 
-def read_obj(path):
+def read_obj(path: str) -> Mesh:
     """Read an OBJ file into a :class:`Mesh`, keeping vertex and face order."""
     with open_input(path, encoding="utf-8", errors="replace") as fh:
         text = fh.read().replace("\\\n", " ")
@@ -254,13 +255,13 @@ def _face_block(mesh, offsets, first, stop):
     return line * sizes.size % tuple((np.column_stack(columns) + 1).ravel().tolist())
 
 
-def format_obj(mesh):
+def format_obj(mesh: Mesh) -> str:
     """OBJ text for ``mesh``: deterministic, coordinates with 17 significant digits."""
     head, faces = _fixed_text(mesh)
     return head + _vertex_lines(mesh) + _uv_lines(mesh) + _normal_lines(mesh) + faces
 
 
-def obj_frames(mesh):
+def obj_frames(mesh: Mesh) -> Callable[[np.ndarray], bytes]:
     """``frame(positions) -> bytes``: the OBJ file of ``mesh`` with other positions (normals
     recomputed for them), as :func:`format_obj` writes it. What the positions do not change
     (statements, texture coordinates, faces) is formatted once."""

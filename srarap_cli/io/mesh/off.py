@@ -3,6 +3,7 @@
 Written by hand because meshio's reader rejects common headers (for example a double space
 in the count line) and libigl's triangulates polygons away.
 """
+
 import numpy as np
 
 from ...runtime.errors import InputError, excerpt
@@ -19,7 +20,7 @@ def _tokens(path):
                 yield line
 
 
-def read_off(path):
+def read_off(path: str) -> Mesh:
     """Read an OFF file into a :class:`Mesh` (vertex normals and ST texture coords kept)."""
     with open_input(path, encoding="utf-8", errors="replace") as fh:
         plain = _read_plain(fh.read())
@@ -106,12 +107,15 @@ def _read_general(path):
     return mesh
 
 
-def format_off(mesh):
+def format_off(mesh: Mesh) -> str:
     """OFF text for ``mesh`` (``NOFF`` when it has per-vertex normals)."""
-    per_vertex_normals = (mesh.normals is not None and len(mesh.normals) == len(mesh.vertices)
+    normals = mesh.normals
+    per_vertex_normals = (normals is not None and len(normals) == len(mesh.vertices)
+                          and mesh.face_normals is not None
                           and np.array_equal(mesh.face_normals, mesh.face_vertices))
     head = "NOFF" if per_vertex_normals else "OFF"
-    cols = np.hstack([mesh.vertices, mesh.normals]) if per_vertex_normals else mesh.vertices
+    cols = np.hstack([mesh.vertices, normals]) if normals is not None and per_vertex_normals \
+        else mesh.vertices
     parts = [f"{head}\n{len(mesh.vertices)} {mesh.face_sizes.size} 0\n"]
     if len(cols):
         parts.append((("%.17g " * (cols.shape[1] - 1) + "%.17g\n") * len(cols))

@@ -3,15 +3,19 @@
 meshio stamps the current time into PLY headers it writes; this writer does not, so the
 same mesh always gives the same bytes.
 """
+
 import numpy as np
+
+from .mesh import Mesh
 
 _PLY_TYPES = {"u1": "uchar", "i1": "char", "u2": "ushort", "i2": "short", "u4": "uint",
               "i4": "int", "f4": "float", "f8": "double"}
 
 
-def per_vertex(mesh, values, refs):
+def per_vertex(mesh: Mesh, values: np.ndarray | None, refs: np.ndarray | None
+               ) -> np.ndarray | None:
     """``values`` as one row per vertex, or None when corners of a vertex disagree."""
-    if values is None:
+    if values is None or refs is None:
         return None
     n = len(mesh.vertices)
     ok = refs >= 0
@@ -24,7 +28,7 @@ def per_vertex(mesh, values, refs):
     return values[first]
 
 
-def format_ply(mesh, ascii=False):
+def format_ply(mesh: Mesh, ascii: bool = False) -> bytes:
     """PLY bytes, binary little-endian (or ``ascii``); per-vertex normals and UVs when they
     are per vertex."""
     n = len(mesh.vertices)

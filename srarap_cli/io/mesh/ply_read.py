@@ -5,6 +5,7 @@ Written by hand because meshio's reader trusts the header: a file claiming 10^8 
 allocated gigabytes before failing, a header without ``end_header`` spun forever, and a face
 with no corners reached libigl and crashed the process.
 """
+
 import numpy as np
 
 from ...runtime.errors import InputError, excerpt
@@ -21,7 +22,7 @@ _FACE_LISTS = ("vertex_indices", "vertex_index")
 _UV_NAMES = (("s", "t"), ("u", "v"), ("texture_u", "texture_v"))
 
 
-def read_ply(path):
+def read_ply(path: str) -> Mesh:
     """Read a PLY file into a :class:`Mesh` (vertex properties kept, polygons kept).
 
     Raises

@@ -48,9 +48,14 @@ rejected, and the plain steps taken instead climb to the fixed point's energy (l
 ``fallback`` rows whose energy rises). The result is still the plain iteration's fixed point
 (2.9e-8 of the diagonal from it there), but those steps cost two local steps each.
 """
+from typing import Any
+
 import numpy as np
 
 from ..quaternion import align_hemisphere, normalize
+from ..state import State
+from ..step import LocalGlobalStep
+from .monitor import Monitor
 
 # history length: on the benchmark cases 10 reached 0.1% of the minimum in as few or fewer
 # iterations than 3, 6 or 15 (Spot: 36 against 71, 44 and 34)
@@ -86,16 +91,19 @@ class AndersonMixer:
     True
     """
 
-    def __init__(self, depth=DEFAULT_DEPTH):
+    def __init__(self, depth: int = DEFAULT_DEPTH) -> None:
         self.depth = depth
         self.reset()
 
-    def reset(self):
-        self._dF = self._dG = self._gram = None
-        self._f = self._g = None
+    def reset(self) -> None:
+        self._dF: np.ndarray | None = None
+        self._dG: np.ndarray | None = None
+        self._gram: np.ndarray | None = None
+        self._f: np.ndarray | None = None
+        self._g: np.ndarray | None = None
         self._count = self._next = 0
 
-    def mix(self, g, f):
+    def mix(self, g: np.ndarray, f: np.ndarray) -> np.ndarray:
         """The next iterate from ``g = G(x)`` and the residual ``f`` (1-D arrays); ``g``
         itself (the same object) when there is no history yet.
 
@@ -107,6 +115,7 @@ class AndersonMixer:
         k = self._count
         if k == 0:
             return g
+        assert self._gram is not None and self._dF is not None and self._dG is not None
         gram = self._gram[:k, :k].copy()
         # the columns are unit vectors: a relative ridge keeps near-dependent ones solvable
         gram[np.diag_indices(k)] += 1e-10
@@ -136,7 +145,8 @@ def _products(rows, v):
     return np.einsum("ij,j->i", rows, v, dtype=float)
 
 
-def anderson_iteration(step, state, monitor, depth=None, correction=None):
+def anderson_iteration(step: LocalGlobalStep, state: State, monitor: Monitor,
+                       depth: int | None = None, correction: Any = None) -> State:
     """Accelerated iteration with an energy safeguard.
 
     Logs one row per accepted iterate: its positions with the rotors the local step gives

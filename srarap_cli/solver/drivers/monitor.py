@@ -15,10 +15,13 @@ gain (vertices within about ``sqrt(tol * EXACT)`` of the edge lengths of the ans
 relative changes of an energy near rounding level are noise that may never settle.
 """
 import time
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
 from ...runtime.errors import NumericalError
+from ..state import State
 from ..stop import StopReason
 
 #: iterates whose mean relative energy change is compared with ``tol``
@@ -29,10 +32,10 @@ EXACT = 1e-6
 FLOOR = 1e-14
 
 
-def recent_changes(log):
+def recent_changes(log: list[dict[str, Any]]) -> list[float]:
     """Relative energy changes of the last WINDOW steps of ``log`` after its latest start row
     (``step`` ending in ``start``), oldest first; what the energy test averages."""
-    changes = []
+    changes: list[float] = []
     for row in reversed(log):
         if row["step"].endswith("start") or len(changes) == WINDOW:
             break
@@ -66,27 +69,28 @@ class Monitor:
     iterations : int, steps recorded after the start
     """
 
-    def __init__(self, *, max_iter, tol, time_limit=None, callback=None, energy_scale=0.0,
-                 scale=float("inf")):
+    def __init__(self, *, max_iter: int, tol: float, time_limit: float | None = None,
+                 callback: Callable[[dict], None] | None = None, energy_scale: float = 0.0,
+                 scale: float = float("inf")) -> None:
         self.max_iter, self.tol, self.time_limit = max_iter, tol, time_limit
         self.move_tol = np.sqrt(max(tol, 0.0)) * scale
         self.callback = callback
         self.energy_floor = FLOOR * energy_scale
         self.exact_energy = max(tol, 0.0) * EXACT * energy_scale
-        self.log = []
+        self.log: list[dict[str, Any]] = []
         self.reason: StopReason | None = None
         self.detail = ""
         self.start = time.perf_counter()
 
     @property
-    def converged(self):
+    def converged(self) -> bool:
         return self.reason is StopReason.CONVERGED
 
     @property
-    def iterations(self):
+    def iterations(self) -> int:
         return max(len(self.log) - 1, 0)
 
-    def record(self, state, previous=None, kind=None):
+    def record(self, state: State, previous: State | None = None, kind: str | None = None) -> bool:
         """Log ``state`` (``previous``: the iterate it came from, None for the start;
         ``kind``: how the driver made it, default ``start`` or ``plain``); returns True
         when the solve should stop."""

@@ -1,7 +1,12 @@
+from collections.abc import Callable
+
+from ..state import State
+from .monitor import Monitor
+
 """The plain fixed-point iteration ``x_{k+1} = G(x_k)``: local step, global step, repeat."""
 
 
-def plain_iteration(step, state, monitor):
+def plain_iteration(step: Callable[[State], State], state: State, monitor: Monitor) -> State:
     """Iterate ``step`` until ``monitor`` says stop.
 
     Parameters

@@ -6,7 +6,11 @@ to ``S_i = sum_j c_ij p_ij q_ij^T``, found directly as a quaternion by
 the SVD to rounding, flat one-rings included, and about twice as fast as libigl's
 ``fit_rotations`` followed by a matrix-to-quaternion conversion).
 """
+
+import numpy as np
+
 from ..closest_rotors import closest_rotors
+from ..rest_edges import RestEdges
 
 
 class ArapRotorStep:
@@ -16,8 +20,9 @@ class ArapRotorStep:
     needs_stretch = False  # the rotation fit needs only S; the energy, only sum_i s_i
     near_minimum = True
 
-    def __init__(self, edges, constrained, alpha_area, feedback):
+    def __init__(self, edges: RestEdges, constrained: np.ndarray, alpha_area: float, feedback: float) -> None:
         """Nothing to precompute: each step fits rotations to the covariances alone."""
 
-    def step(self, S, s, R_prev, forcing=0.0):  # closed form: no forcing
+    def step(self, S: np.ndarray, s: np.ndarray | None, R_prev: np.ndarray,
+             forcing: float = 0.0) -> np.ndarray:  # closed form: no forcing
         return closest_rotors(S, R_prev)

@@ -10,7 +10,8 @@ import numpy as np
 from ..quaternion import normalize
 
 
-def constrained_rotors(D, neighbour_pull, feedback_pull, R_prev):
+def constrained_rotors(D: np.ndarray, neighbour_pull: np.ndarray, feedback_pull: np.ndarray,
+                       R_prev: np.ndarray) -> np.ndarray:
     """Solve ``D_i R_i = neighbour_pull_i + feedback_pull_i`` per constrained cell, normalized.
 
     Parameters

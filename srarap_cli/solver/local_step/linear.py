@@ -9,6 +9,7 @@ symmetric positive definite, solved by :class:`~.rotor_system.RotorSystem`.
 """
 import numpy as np
 
+from ..rest_edges import RestEdges
 from .feedback import paper_feedback
 from .rotor_system import RotorSystem
 
@@ -21,7 +22,8 @@ class LinearRotorStep(RotorSystem):
     # its fixed point sits 1.3% to 5% above the minimum (see docs/background/method.md)
     near_minimum = False
 
-    def __init__(self, edges, constrained, alpha_area, feedback):
+    def __init__(self, edges: RestEdges, constrained: np.ndarray, alpha_area: float,
+                 feedback: float) -> None:
         graph = edges.graph
         scale = (graph.degree + feedback).astype(float)
         super().__init__(edges, constrained, sigma=scale, tau=scale * alpha_area,

@@ -9,11 +9,13 @@ neighbour times eps, as in the paper's row). Same handle-rotor rule and normaliz
 """
 import numpy as np
 
+from ..operators import CellGraph
+from ..rest_edges import RestEdges
 from .feedback import proximal_feedback
 from .rotor_system import RotorSystem
 
 
-def symmetric_weights(graph):
+def symmetric_weights(graph: CellGraph) -> np.ndarray:
     """``w_ij + w_ji = 1/deg_i + 1/deg_j`` per directed edge."""
     inv = 1.0 / graph.degree.clip(min=1)
     return inv[graph.I] + inv[graph.J]
@@ -26,7 +28,8 @@ class SymmetricRotorStep(RotorSystem):
     needs_stretch = True
     near_minimum = True
 
-    def __init__(self, edges, constrained, alpha_area, feedback):
+    def __init__(self, edges: RestEdges, constrained: np.ndarray, alpha_area: float,
+                 feedback: float) -> None:
         graph = edges.graph
         W = symmetric_weights(graph)
         row_sum = graph.cell_sum(W)

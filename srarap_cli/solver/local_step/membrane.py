@@ -16,7 +16,7 @@ _TWICE_BASIS_ROWS = 2.0 * PRODUCT_BASIS.reshape(9, 16)
 _DIAG = np.arange(4)
 
 
-def membrane_matrices(S, s):
+def membrane_matrices(S: np.ndarray, s: np.ndarray) -> np.ndarray:
     """``M_i = s_i I + 2 sum_ab S_i[a, b] Lmul(e_a) Rmul(e_b)``: (n, 4, 4) symmetric PSD.
 
     Examples

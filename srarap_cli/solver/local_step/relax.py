@@ -11,7 +11,9 @@ is one vectorized update.
 import numpy as np
 import scipy.sparse as sp
 
+from ..operators import CellGraph
 from ..quaternion import align_hemisphere
+from ..rest_edges import RestEdges
 from .feedback import feedback_pull, proximal_feedback
 from .linear_sym import symmetric_weights
 from .membrane import membrane_matrices
@@ -19,7 +21,7 @@ from .membrane import membrane_matrices
 _NEWTON_STEPS = 40
 
 
-def colour_classes(graph, seed=0):
+def colour_classes(graph: CellGraph, seed: int = 0) -> list[np.ndarray]:
     """Vertex colour classes (list of int arrays), neighbours never sharing a colour.
 
     Jones-Plassmann rounds: every uncoloured vertex whose random priority beats all its
@@ -38,7 +40,8 @@ def colour_classes(graph, seed=0):
     return classes
 
 
-def best_unit_rotor(lam, Q, b, fallback):
+def best_unit_rotor(lam: np.ndarray, Q: np.ndarray, b: np.ndarray,
+                    fallback: np.ndarray) -> np.ndarray:
     """``argmin_{|R|=1} R^T M R - 2 b . R`` for stacks of ``M = Q diag(lam) Q^T``.
 
     Parameters
@@ -99,7 +102,8 @@ class RelaxRotorStep:
     needs_stretch = True
     near_minimum = True
 
-    def __init__(self, edges, constrained, alpha_area, feedback, sweeps=2):
+    def __init__(self, edges: RestEdges, constrained: np.ndarray, alpha_area: float,
+                 feedback: float, sweeps: int = 2) -> None:
         graph = edges.graph
         W = symmetric_weights(graph)
         self._W = sp.csr_matrix((alpha_area * W, (graph.I, graph.J)), shape=(graph.n,) * 2)
@@ -107,7 +111,9 @@ class RelaxRotorStep:
         self._rows = [(c, self._W[c]) for c in colour_classes(graph)]
         self.sweeps = int(sweeps)
 
-    def step(self, S, s, R_prev, forcing=0.0):  # exact per-cell fits: forcing unused
+    def step(self, S: np.ndarray, s: np.ndarray | None, R_prev: np.ndarray,
+             forcing: float = 0.0) -> np.ndarray:  # exact per-cell fits: forcing unused
+        assert s is not None  # needs_stretch: the step passes the stretch
         lam, Q = np.linalg.eigh(membrane_matrices(S, s))
         R = R_prev.copy()
         for _ in range(self.sweeps):

@@ -31,9 +31,11 @@ from functools import partial
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.sparse import csr_matrix
 
 from ..linalg import factor
 from ..quaternion import normalize
+from ..rest_edges import RestEdges
 from .constrained_rotors import constrained_rotors
 from .feedback import feedback_pull
 from .membrane import membrane_matrices
@@ -56,7 +58,8 @@ class RotorSystem:
     omega : (m,) float array, symmetric edge weights aligned with ``graph.I, graph.J``
     """
 
-    def __init__(self, edges, constrained, sigma, tau, phi, omega):
+    def __init__(self, edges: RestEdges, constrained: np.ndarray, sigma: np.ndarray, tau: np.ndarray,
+                 phi: np.ndarray, omega: np.ndarray) -> None:
         graph = edges.graph
         self.free = np.flatnonzero(~constrained)
         self.fixed = np.flatnonzero(constrained)
@@ -84,7 +87,7 @@ class RotorSystem:
             self._precondition, self._powers = self._factor_scalar(powers), powers
         return self._precondition
 
-    def diagonal_blocks(self, S, s):
+    def diagonal_blocks(self, S: np.ndarray, s: np.ndarray) -> np.ndarray:
         """``sigma_i M_i + tau_i I`` (plus a tiny scale-relative shift): (n, 4, 4)."""
         D = membrane_matrices(S, s)
         size = max(float(D.max(initial=0)), -float(D.min(initial=0)))  # no |D| temporary
@@ -94,7 +97,8 @@ class RotorSystem:
         D[:, _DIAG, _DIAG] += (self.tau + shift)[:, None]
         return D
 
-    def free_system(self, D, R_prev, R_fixed):
+    def free_system(self, D: np.ndarray, R_prev: np.ndarray, R_fixed: np.ndarray
+                    ) -> tuple["FreeRotorMatrix", np.ndarray]:
         """The free rotors' matrix (a :class:`FreeRotorMatrix`) and right-hand side
         (flattened, 4 per free vertex)."""
         A = FreeRotorMatrix(D[self.free], self._coupling)
@@ -102,7 +106,7 @@ class RotorSystem:
         b = feedback_pull(self.phi[self.free], R_prev[self.free]) + self._free_to_fixed @ R_fixed
         return A, b.ravel()
 
-    def step(self, S, s, R_prev, forcing=0.0):
+    def step(self, S: np.ndarray, s: np.ndarray, R_prev: np.ndarray, forcing: float = 0.0) -> np.ndarray:
         """New unit rotors: constrained rotors from their own rows (section 6.2), then one
         solve for all free rotors, to ``forcing`` times the previous rotors' residual."""
         D = self.diagonal_blocks(S, s)
@@ -148,7 +152,7 @@ class FreeRotorMatrix(spla.LinearOperator):
     W : (nf, nf) sparse matrix, symmetric coupling weights
     """
 
-    def __init__(self, D, W):
+    def __init__(self, D: np.ndarray, W: csr_matrix) -> None:
         super().__init__(dtype=float, shape=(4 * D.shape[0],) * 2)
         self.D, self.W = D, W
 
@@ -158,7 +162,7 @@ class FreeRotorMatrix(spla.LinearOperator):
         out -= self.W @ X
         return out.ravel()
 
-    def tocsr(self):
+    def tocsr(self) -> csr_matrix:
         """The assembled sparse matrix (for the direct fallback)."""
         nf = self.D.shape[0]
         blocks = sp.bsr_matrix((self.D, np.arange(nf), np.arange(nf + 1)), shape=self.shape)

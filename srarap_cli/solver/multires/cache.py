@@ -2,6 +2,7 @@
 import hashlib
 import io
 import os
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -13,7 +14,7 @@ from .simplify import CoarseMesh, simplify_to_subset
 FORMAT = "srarap-coarse-2"
 
 
-def cache_key(V, F, size, groups):
+def cache_key(V: np.ndarray, F: np.ndarray, size: int, groups: Sequence[np.ndarray]) -> str:
     """Hex digest of the mesh, the wanted size, the constrained groups and the simplifier."""
     h = hashlib.sha256()
     for part in (FORMAT, str(int(size)), str(len(groups))):
@@ -25,7 +26,8 @@ def cache_key(V, F, size, groups):
     return h.hexdigest()
 
 
-def coarse_mesh(V, F, size, groups, cache_dir=None):
+def coarse_mesh(V: np.ndarray, F: np.ndarray, size: int, groups: list[np.ndarray],
+                cache_dir: str | None = None) -> tuple[CoarseMesh, bool, list[str]]:
     """:func:`simplify_to_subset`, through ``cache_dir`` when given.
 
     Returns

@@ -11,6 +11,7 @@ pairwise disjoint is applied at once. Disjoint rings make the collapses independ
 changes the faces, neighbours or quadrics another one was checked against, and no vertex
 moves, so every check made at the start of the round still holds when all are applied.
 """
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -36,7 +37,7 @@ MIN_QUALITY = 0.3
 PASSES = 8
 
 
-def collapse_to(V, F, size, frozen):
+def collapse_to(V: np.ndarray, F: np.ndarray, size: int, frozen: np.ndarray) -> np.ndarray:
     """Collapse (V, F) until at most ``size`` vertices remain or nothing can collapse.
 
     Parameters

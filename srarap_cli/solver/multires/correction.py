@@ -25,6 +25,7 @@ import numpy as np
 from ..drivers.anderson import AndersonMixer
 from ..group_rotations import label_sum
 from ..quaternion import align_hemisphere, normalize
+from ..step import LocalGlobalStep
 
 #: coarse steps per correction (Anderson-mixed); 10 took the 46k Spot to 1e-4 in 24
 #: iterations instead of 16 (a correction every third iteration)
@@ -62,7 +63,8 @@ class CoarseCorrection:
     every : int, a correction every ``every`` iterations
     """
 
-    def __init__(self, coarse_step, coarse_vertices, nearest, inner=None):
+    def __init__(self, coarse_step: LocalGlobalStep, coarse_vertices: np.ndarray,
+                 nearest: np.ndarray, inner: "CoarseCorrection | None" = None) -> None:
         self.step, self.inner = coarse_step, inner
         self.vertices = np.asarray(coarse_vertices)
         self.nearest = np.asarray(nearest)
@@ -72,11 +74,11 @@ class CoarseCorrection:
         self._weight = 1.0 / np.maximum(size, 1)
         self.every = 1 if self.nearest.size >= EVERY_STEP_RATIO * self.vertices.size else 2
 
-    def due(self, iteration):
+    def due(self, iteration: int) -> bool:
         """Whether the iterate numbered ``iteration`` gets a correction."""
         return iteration % self.every == 0
 
-    def __call__(self, rotors, residual):
+    def __call__(self, rotors: np.ndarray, residual: np.ndarray) -> np.ndarray | None:
         """The correction (n, 4) to add to the rotors of the iterate after ``rotors``.
 
         Parameters

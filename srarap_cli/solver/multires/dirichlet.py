@@ -1,6 +1,8 @@
 """One factorization of the fine Laplacian with Dirichlet vertices, for many solves."""
+
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse import csr_matrix
 
 from ..libigl import igl
 
@@ -24,14 +26,14 @@ class DirichletSolver:
     [0.0, 1.0, 2.0]
     """
 
-    def __init__(self, K, known):
+    def __init__(self, K: csr_matrix, known: np.ndarray) -> None:
         self.n = K.shape[0]
         self.known = np.asarray(known, dtype=np.int64)
         self._data = igl.min_quad_with_fixed_data()
         igl.min_quad_with_fixed_precompute(sp.csc_matrix(K, dtype=float), self.known,
                                            sp.csc_matrix((0, self.n)), True, self._data)
 
-    def solve(self, Y, B=None):
+    def solve(self, Y: np.ndarray, B: np.ndarray | None = None) -> np.ndarray:
         """Solution (n, c) with rows ``known`` equal to ``Y`` (k, c); ``B`` (n, c) or zero."""
         Y = np.ascontiguousarray(Y, dtype=float)
         B = np.zeros((self.n, Y.shape[1])) if B is None else np.ascontiguousarray(B, float)

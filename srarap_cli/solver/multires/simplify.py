@@ -7,6 +7,7 @@ implementation used MeshLab's collapse with optimal placement off for the same r
 Borders slide only along themselves, the link condition keeps the surface manifold, and no
 collapse flips a triangle.
 """
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,7 +32,8 @@ class CoarseMesh:
     warnings: list
 
 
-def simplify_to_subset(V, F, size, groups=()):
+def simplify_to_subset(V: np.ndarray, F: np.ndarray, size: int,
+                       groups: Sequence[np.ndarray] = ()) -> CoarseMesh:
     """Quadric-error half-edge collapses of (V, F) down to about ``size`` vertices.
 
     Every group keeps at least one coarse vertex: its vertex nearest the group's centroid

@@ -20,7 +20,7 @@ AUTO_RATIO = 8
 MIN_SIZE = 4
 
 
-def parse_size(text):
+def parse_size(text: object) -> int | float | str:
     """Validate a multires setting: ``"off"``, ``"auto"``, an int >= 4, ``"P%"`` or a
     fraction strictly between 0 and 1 (``0.02``: what ``"2%"`` parses to).
 
@@ -68,7 +68,7 @@ def _fraction(value):
     return float(value)
 
 
-def coarse_size(setting, n):
+def coarse_size(setting: int | float | str | None, n: int) -> int | None:
     """Coarse vertex count for a mesh of ``n`` vertices, or None for a direct solve."""
     if setting is None or setting == "auto":
         return max(AUTO_SIZE, n // AUTO_RATIO) if n >= AUTO_THRESHOLD else None

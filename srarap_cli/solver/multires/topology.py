@@ -1,4 +1,5 @@
 """Topological invariants of a triangle mesh, to check that simplification kept them."""
+
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse import csgraph
@@ -6,7 +7,7 @@ from scipy.sparse import csgraph
 from ..mesh_checks import edge_counts
 
 
-def topology_summary(F, n):
+def topology_summary(F: np.ndarray, n: int) -> dict[str, int | bool]:
     """Counts that a genus-preserving simplification must keep.
 
     Parameters

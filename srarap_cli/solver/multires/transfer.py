@@ -5,9 +5,10 @@ import numpy as np
 
 from ..group_rotations import label_sum
 from ..quaternion import IDENTITY, align_hemisphere, normalize
+from .dirichlet import DirichletSolver
 
 
-def spread_rotors(solver, known_rotors):
+def spread_rotors(solver: DirichletSolver, known_rotors: np.ndarray) -> np.ndarray:
     """Harmonic rotor field: ``L R = 0`` with ``R = known_rotors`` at ``solver.known``,
     four right-hand sides, then normalized.
 
@@ -33,7 +34,8 @@ def spread_rotors(solver, known_rotors):
     return normalize(R, np.broadcast_to(IDENTITY, R.shape))
 
 
-def orient_group_rotors(rotors, determined, labels, n_groups, coarse_slots, coarse_rotors):
+def orient_group_rotors(rotors: np.ndarray, determined: np.ndarray, labels: np.ndarray, n_groups: int,
+                        coarse_slots: np.ndarray, coarse_rotors: np.ndarray) -> np.ndarray:
     """Rotors for all constrained vertices, on the hemisphere of the coarse solution.
 
     Each group's rotor is flipped toward the sum of the coarse rotors of its vertices that

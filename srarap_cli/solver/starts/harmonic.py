@@ -11,9 +11,11 @@ import numpy as np
 
 from ..group_rotations import group_rotors, label_sum
 from ..quaternion import IDENTITY, align_hemisphere, normalize
+from ..state import State
+from ..step import LocalGlobalStep
 
 
-def harmonic_start(step, initial=None):
+def harmonic_start(step: LocalGlobalStep, initial: object = None) -> State:
     """Start from the handles' rotations, harmonically interpolated.
 
     Parameters
@@ -29,7 +31,7 @@ def harmonic_start(step, initial=None):
     return step.state(step.positions(R), R)
 
 
-def spread_handle_rotors(step, P):
+def spread_handle_rotors(step: LocalGlobalStep, P: np.ndarray) -> np.ndarray:
     """Rotors (n, 4): each handle group's best-fit rotation from its vertices' positions in
     ``P`` (n, 3) to the step's targets, spread harmonically (immovable vertices keep the
     identity) and normalized."""
@@ -41,7 +43,7 @@ def spread_handle_rotors(step, P):
     return normalize(R, np.broadcast_to(IDENTITY, R.shape))
 
 
-def handle_rotors(rest, targets, labels):
+def handle_rotors(rest: np.ndarray, targets: np.ndarray, labels: np.ndarray) -> np.ndarray:
     """One rotor per constrained vertex: its group's best-fit rotation, on the hemisphere
     ``w >= 0`` (so that rotations spread the short way from the identity). A group whose
     rest points are collinear fixes no rotation: it takes the mean of the determined groups'

@@ -2,9 +2,11 @@
 import numpy as np
 
 from ..quaternion import IDENTITY
+from ..state import State
+from ..step import LocalGlobalStep
 
 
-def laplacian_start(step, initial=None):
+def laplacian_start(step: LocalGlobalStep, initial: object = None) -> State:
     """Identity rotors everywhere, positions from one global step.
 
     Parameters

@@ -21,13 +21,16 @@ minimum: for the paper's own system (``sr-linear``), whose fixed point sits 1.3%
 it, the lower-energy start was the farther one (Spot scaled by 1.01: 27 iterations, against
 26 with the rotations only), so that method keeps the first candidate alone.
 """
+
 import numpy as np
 
 from ..quaternion import from_rotation_vectors, multiply, normalize
+from ..state import State
+from ..step import LocalGlobalStep
 from .harmonic import spread_handle_rotors
 
 
-def warm_start(step, initial):
+def warm_start(step: LocalGlobalStep, initial: tuple[np.ndarray, np.ndarray]) -> State:
     """Start from ``initial = (positions (n, 3), rotors (n, 4))``, a solved state, moved by
     the handles' change: the lower-energy of the two candidates above.
 
@@ -49,7 +52,8 @@ def warm_start(step, initial):
     return predicted if predicted.total < best.total else best
 
 
-def extrapolated_start(step, initial):
+def extrapolated_start(step: LocalGlobalStep,
+                       initial: tuple[np.ndarray, np.ndarray]) -> State:
     """Start from ``initial = (positions (n, 3), rotors (n, 4))`` with only the handles'
     rotations since then spread (the first candidate above): for a state that already
     follows the targets to first order, such as an animation's last frames carried on at

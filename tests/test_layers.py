@@ -1,0 +1,143 @@
+"""The rules of docs/background/architecture.md, checked on the code's own imports: five
+layers, each importing only those below it; no import cycle; every layer's ``__init__``
+states its rule; every public function in every layer has type hints (mypy, run over the
+whole package in CI, then checks their bodies)."""
+import ast
+import os
+import re
+
+import pytest
+from helpers import ROOT
+
+PACKAGE = os.path.join(ROOT, "srarap_cli")
+#: bottom to top; the package's own top-level modules (entry, __main__) sit above them all
+LAYERS = ("runtime", "solver", "io", "tasks", "cli")
+
+
+def _modules():
+    """module name -> path, every module of the package but the sample data's scripts."""
+    out = {}
+    for folder, dirs, files in os.walk(PACKAGE):
+        dirs[:] = [d for d in dirs if d not in ("data", "__pycache__")]
+        for name in files:
+            if name.endswith(".py"):
+                path = os.path.join(folder, name)
+                parts = os.path.relpath(path, ROOT)[:-3].split(os.sep)
+                out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _layer(module):
+    parts = module.split(".")
+    return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else len(LAYERS)
+
+
+def _imports(module, path):
+    """The package's modules ``module`` imports at run time (anywhere in it, functions too;
+    not what an ``if TYPE_CHECKING:`` block imports for annotations only)."""
+    tree = ast.parse(open(path, encoding="utf-8").read())
+    hidden = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If)
+              and getattr(node.test, "id", "") == "TYPE_CHECKING" for n in ast.walk(node)}
+    package = module if path.endswith("__init__.py") else module.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(tree):
+        if id(node) in hidden:
+            continue
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[:len(package.split(".")) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            for alias in node.names:
+                sub = f"{target}.{alias.name}"
+                found.add(sub if sub in MODULES else target)
+        elif isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+    return {m for m in found if m in MODULES and m != module}
+
+
+GRAPH = {m: _imports(m, p) for m, p in MODULES.items()}
+
+
+def test_the_graph_is_read():
+    assert len(MODULES) > 100 and sum(map(len, GRAPH.values())) > 300
+    assert "srarap_cli.solver.deformer" in GRAPH["srarap_cli.tasks.pipeline"]
+
+
+def test_no_layer_imports_a_layer_above_it():
+    upward = [f"{m} -> {t}" for m, targets in GRAPH.items() for t in targets
+              if _layer(t) > _layer(m)]
+    assert upward == []
+
+
+def test_the_import_graph_has_no_cycle():
+    """Depth-first search; a module met again on the current path closes a cycle."""
+    state, cycles = {}, []
+
+    def visit(m, path):
+        state[m] = "open"
+        for t in sorted(GRAPH[m]):
+            if state.get(t) == "open":
+                cycles.append(path[path.index(t):] + [t])
+            elif t not in state:
+                visit(t, path + [t])
+        state[m] = "done"
+
+    for m in sorted(GRAPH):
+        if m not in state:
+            visit(m, [m])
+    assert cycles == []
+
+
+@pytest.mark.parametrize("layer", LAYERS)
+def test_every_layer_states_its_rule(layer):
+    """The ``Rule:`` paragraph of the layer's docstring names every layer below it before any
+    ``never``, and no layer above it there."""
+    doc = ast.get_docstring(ast.parse(open(os.path.join(PACKAGE, layer, "__init__.py")).read()))
+    rule = re.search(r"^Rule: (.*?)(?:\n\n|$)", doc or "", re.M | re.S)
+    assert rule, f"{layer}/__init__.py states no rule"
+    allowed = rule.group(1).split("never")[0]
+    below, above = LAYERS[:LAYERS.index(layer)], LAYERS[LAYERS.index(layer) + 1:]
+    assert all(f"``{b}``" in allowed for b in below), allowed
+    assert not any(f"``{a}``" in allowed for a in above), allowed
+    if not below:
+        assert "nothing else of srarap" in allowed
+
+
+def _public_functions(tree):
+    """Top-level functions and the methods of top-level classes whose names are public."""
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef) and not node.name.startswith("_"):
+            yield node
+        elif isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+            for item in node.body:
+                if isinstance(item, ast.FunctionDef) and (
+                        not item.name.startswith("_") or item.name == "__init__"):
+                    yield item
+
+
+def test_every_public_function_in_every_layer_is_type_hinted():
+    loose = []
+    for path in sorted(MODULES.values()):
+        tree = ast.parse(open(path, encoding="utf-8").read())
+        for node in _public_functions(tree):
+            args = node.args.posonlyargs + node.args.args + node.args.kwonlyargs
+            args = [a for a in args if a.arg not in ("self", "cls")]
+            args += [a for a in (node.args.vararg, node.args.kwarg) if a is not None]
+            if (node.returns is None and node.name != "__init__") or any(
+                    a.annotation is None for a in args):
+                loose.append(f"{os.path.relpath(path, ROOT)}:{node.lineno} {node.name}")
+    assert loose == []
+
+
+def test_mypy_runs_over_the_whole_package():
+    import tomllib
+    with open(os.path.join(ROOT, "pyproject.toml"), "rb") as fh:
+        mypy = tomllib.load(fh)["tool"]["mypy"]
+    assert mypy["files"] == ["srarap_cli"]
+    with open(os.path.join(ROOT, ".ci", "run")) as fh:
+        assert re.search(r"^mypy$", fh.read(), re.M)
