@@ -14,14 +14,15 @@ import functools
 import os
 import threading
 from collections.abc import Callable
-from typing import TypeVar
+from typing import Any, TypeVar, cast
 
 T = TypeVar("T")
+F = TypeVar("F", bound=Callable[..., Any])
 
 _VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 
-def single_threaded(func: Callable) -> Callable:
+def single_threaded(func: F) -> F:
     """Run ``func`` with every BLAS library limited to one thread (threadpoolctl)."""
 
     @functools.wraps(func)
@@ -31,7 +32,7 @@ def single_threaded(func: Callable) -> Callable:
         with threadpool_limits(limits=1, user_api="blas"):
             return func(*args, **kwargs)
 
-    return wrapper
+    return cast(F, wrapper)
 
 
 def pin_process() -> None:

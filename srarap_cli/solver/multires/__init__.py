@@ -5,7 +5,7 @@ Names are imported on first use, so that reading the settings (``size``) does no
 simplifier or the solver.
 """
 import importlib
-from collections.abc import Callable
+from typing import Any
 
 _WHERE = {"MultiresDeformer": "deformer", "MultiresResult": "deformer",
           "CoarseMesh": "simplify", "simplify_to_subset": "simplify",
@@ -15,7 +15,7 @@ __all__ = ["CoarseMesh", "MultiresDeformer", "MultiresResult", "coarse_size", "p
            "simplify_to_subset"]
 
 
-def __getattr__(name: str) -> Callable:
+def __getattr__(name: str) -> Any:
     if name not in _WHERE:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     return getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
