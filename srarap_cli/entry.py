@@ -7,10 +7,11 @@ neither a background thread nor a late signal can turn a finished run into a cra
 """
 import sys
 
-from .runtime import clock, signals  # noqa: F401 -- the clock starts with the process
+from .runtime import clock, descriptors, signals  # noqa: F401 -- the clock starts with the process
 
 
 def main() -> None:
+    descriptors.reopen_closed()
     signals.own()
     code = 1
     try:

@@ -164,7 +164,7 @@ def test_stl_reads_the_same_vertices_in_the_same_order_as_meshio(tmp_path, binar
 
 @pytest.mark.parametrize("text, message", [
     ("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-     "endloop\nendfacet\n", "no 'endsolid'"),
+     "endloop\nendfacet\n", "does not end with 'endsolid'"),
     ("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
      "endloop\nendfacet\nendsolid t\n", "facet 0 is incomplete"),
     ("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"

@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from ..io.handles import load_handles, referenced_files
-from ..io.mesh import frame_formatter, read_mesh
+from ..io.mesh import format_mesh, frame_formatter, read_mesh
 from ..io.mesh.formats import extensions
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime import exit_codes
@@ -70,8 +70,9 @@ def animate(mesh: str, handles: str, pattern: str, frames: int | None, fps: floa
     continues an interrupted run and gives the same files as an uninterrupted one. Exit
     codes: 0 every frame converged and was written; 3 a frame did not converge: the sequence
     stops before it (frames so far and the log are written; --keep-unconverged writes it and
-    goes on). With --iters-per-frame N
-    (fixed budget) every frame is written and the exit code is 0.
+    goes on; later frames an earlier run left under the pattern are removed, so that the
+    sequence on disk is this run's). With --iters-per-frame N (fixed budget) every frame is
+    written and the exit code is 0.
     """
     folder = _check_pattern(pattern)
     if log is not None:
@@ -79,9 +80,11 @@ def animate(mesh: str, handles: str, pattern: str, frames: int | None, fps: floa
     source = read_mesh(mesh)
     check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices, fps=fps)
-    n_frames = _frame_count(frames, constraints.last_key_frame, max_frames, handles)
+    n_frames = _frame_count(frames, constraints.last_key_frame, max_frames, handles, fps)
     state_path = os.path.join(folder, STATE_NAME)
-    refuse_overwrite([pattern.format(f) for f in range(n_frames)] + [log], mesh=mesh,
+    # only existing files can be inputs: the folder is listed, the frames never enumerated
+    on_disk = _frames_on_disk(pattern)
+    refuse_overwrite([p for k, p in on_disk.items() if k < n_frames] + [log], mesh=mesh,
                      handles=handles, others=[("resume state", state_path)])
     opts = resolve(constraints.solver, overrides)
     run_id = fingerprint((mesh, handles, *referenced_files(handles)), opts, n_frames, fps,
@@ -91,6 +94,7 @@ def animate(mesh: str, handles: str, pattern: str, frames: int | None, fps: floa
     progress = _Progress(n_frames, enabled=verbosity != 0 and sys.stderr.isatty())
 
     frame_bytes = frame_formatter(source, _suffix(pattern))
+    lost = format_mesh(source, _suffix(pattern))[1]  # what every frame's file loses, said once
 
     def write_frame(f, positions, st):
         commit_files([(pattern.format(f), frame_bytes(positions)), (state_path, st.to_bytes())])
@@ -110,7 +114,13 @@ def animate(mesh: str, handles: str, pattern: str, frames: int | None, fps: floa
     stopped = animator.stopped_at
     if stopped is None and os.path.exists(state_path):
         os.unlink(state_path)
-    report(verbosity, warnings=animator.warnings,
+    notes = animator.warnings + lost
+    if stopped is not None:
+        removed = _remove_stale(pattern, stopped)
+        if removed:
+            notes.append(f"removed {removed} later frame(s) of an earlier run under {pattern!r} "
+                         f"(frame {stopped} on), so that the frames on disk are this run's")
+    report(verbosity, warnings=notes,
            details=animator.last_result.report_lines() if animator.last_result else [],
            summary=_summary(rows, state, n_frames, pattern, stopped, iters_per_frame,
                             animator.last_result))
@@ -142,15 +152,45 @@ def _summary(rows, state, n_frames, pattern, stopped, budget, result):
     return head
 
 
-def _frame_count(frames, last_key_frame, max_frames, handles):
+def _frame_count(frames, last_key_frame, max_frames, handles, fps):
     n = frames if frames is not None else (
         math.floor(last_key_frame) + 1 if math.isfinite(last_key_frame) else math.inf)
     if n > max_frames:
-        why = "--frames" if frames is not None else f"the last keyframe of {handles} (with --fps)"
+        why = "--frames" if frames is not None else (
+            f"the last keyframe of {handles}" + (f" (at --fps {fps:g})" if fps else ""))
         shown = f"{n:.3g}" if isinstance(n, float) else str(n)
         raise InputError(f"{why} makes {shown} frames, more than --max-frames {max_frames}; "
                          "raise --max-frames to render them")
     return int(n)
+
+
+def _frames_on_disk(pattern):
+    """frame number -> path of the files in the pattern's folder that the pattern names."""
+    literal = [(text, field) for text, field, _, _ in string.Formatter().parse(pattern)]
+    head, tail = literal[0][0], "".join(text for text, _ in literal[1:])
+    folder, head = os.path.split(head)
+    name = re.compile(re.escape(head) + r" *(\d+)" + re.escape(tail))
+    found = {}
+    for entry in os.listdir(folder or "."):
+        match = name.fullmatch(entry)
+        if match and os.path.basename(pattern.format(int(match.group(1)))) == entry:
+            found[int(match.group(1))] = os.path.join(folder, entry)
+    return found
+
+
+def _remove_stale(pattern, first):
+    """Remove the frames from ``first`` on that an earlier run left under ``pattern``;
+    returns how many."""
+    stale = [path for k, path in _frames_on_disk(pattern).items() if k >= first]
+    for path in stale:
+        try:
+            os.unlink(path)
+        except FileNotFoundError:
+            pass
+        except OSError as exc:
+            raise OutputError(f"{path}: cannot remove a frame of an earlier run: "
+                              f"{exc.strerror}") from None
+    return len(stale)
 
 
 def _fields(pattern):

@@ -3,6 +3,7 @@ import csv
 import io
 import json
 import os
+import re
 
 import click
 
@@ -11,6 +12,9 @@ from ..runtime.commit import commit_files
 from ..runtime.errors import OutputError
 from ..tasks.batch import SUMMARY_FIELDS, check_outputs, load_manifest, run_batch
 from .common import guarded
+
+#: a Dask scheduler address: protocol://host:port, or host:port
+SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
 
 
 @click.command("batch")
@@ -37,6 +41,9 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     --keep-unconverged; the status is recorded, so an unchanged job reports it again on every
     rerun without solving).
     """
+    if scheduler is not None and scheduler != "local" and not SCHEDULER.fullmatch(scheduler):
+        raise click.BadParameter(f"{scheduler!r} is neither 'local' nor a scheduler address "
+                                 "such as tcp://host:8786", param_hint="--scheduler")
     jobs = load_manifest(manifest)
     check_outputs(jobs, out, manifest)
     try:

@@ -126,10 +126,11 @@ def _classify(exc):
                                        "(rerun with --debug for the traceback and report it)")
 
 
-def check_output_path(path: str, allowed: Sequence[str], what: str) -> None:
-    """Fail before any work when an output could not be written."""
+def check_output_path(path: str, allowed: Sequence[str] | None, what: str) -> None:
+    """Fail before any work when an output could not be written (``allowed``: its
+    extensions; None when the format is given otherwise)."""
     ext = os.path.splitext(path)[1].lower()
-    if ext not in allowed:
+    if allowed is not None and ext not in allowed:
         raise click.UsageError(f"{what} {path!r}: extension must be one of {', '.join(allowed)}")
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):

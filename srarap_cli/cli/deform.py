@@ -10,8 +10,9 @@ from ..io.handles import load_handles
 from ..io.mesh import FORMATS
 from ..io.mesh.formats import MeshFormat, by_extension, extensions
 from ..io.solve_log import LOG_FORMATS, format_log
-from ..runtime import exit_codes
+from ..runtime import descriptors, exit_codes
 from ..runtime.commit import commit_files
+from ..runtime.errors import OutputError
 from ..runtime.limits import check_solve
 from ..solver.multires.size import AUTO_THRESHOLD
 from ..solver.settings import resolve
@@ -74,8 +75,11 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
     fmt = _output_format(out, out_format, mesh)
     if fmt is not None:
         _check_format_options(fmt, ascii, write_distortion)
-    if out != "-":
-        check_output_path(out, extensions(), "output")
+    if out != "-":  # an extension the table knows, or --format for a name without one
+        check_output_path(out, None if by_extension(out) is None and out_format else extensions(),
+                          "output")
+    elif descriptors.closed(1):
+        raise OutputError("-o -: standard output is closed; name an output file")
     if preview is not None:
         check_output_path(preview, (".png",), "preview")
     if log is not None:
@@ -101,7 +105,7 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
     done = result.complete
-    mesh_bytes, lost = fmt.write(deformed, ascii)
+    mesh_bytes, lost = fmt.encode(deformed, ascii)
     keep = done or keep_unconverged
     files = [(out, mesh_bytes)] if keep and out != "-" else []
     if preview is not None and keep:
@@ -109,9 +113,9 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
                                                   up=preview_up)))
     if log is not None:
         files.append((log, format_log(result.log, os.path.splitext(log)[1].lower()).encode()))
-    commit_files(files)
-    if keep and out == "-":
+    if keep and out == "-":  # first: the files are committed only once it was written
         write_stdout(mesh_bytes)
+    commit_files(files)
     shown = "<stdout>" if out == "-" else out
     report(verbosity, warnings=notes + lost, details=result.report_lines(),
            summary=_summary(result, opts, shown if keep else None))
@@ -125,9 +129,9 @@ def _output_format(out, out_format, mesh):
     if out == "-":
         return out_format or (None if mesh == "-" else by_extension(mesh))
     fmt = by_extension(out)
-    if out_format is not None and fmt is not out_format:
+    if out_format is not None and fmt is not None and fmt is not out_format:
         raise click.UsageError(f"--format {out_format.name} does not match the output {out!r}")
-    return fmt
+    return fmt or out_format
 
 
 def _check_format_options(fmt, ascii, write_distortion):

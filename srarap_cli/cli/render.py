@@ -124,6 +124,8 @@ def _read_log(path):
                 rows = list(csv.DictReader(fh))
             else:
                 rows = [json.loads(line) for line in fh if line.strip()]
+    except RecursionError:  # json nests as deep as the text does: a hostile line
+        raise InputError(f"{path}: not a readable log (a row nested too deeply)") from None
     except (OSError, ValueError) as exc:
         raise InputError(f"{path}: not a readable log ({exc})") from None
     fields = ("iteration", "total", "seconds")

@@ -23,6 +23,9 @@ def samples(folder: str, force: bool, quiet: bool) -> None:
     Then, for example: srarap deform FOLDER/sample_meshes/bar.obj FOLDER/configs/bar-twist.yaml
     -o twisted.obj
     """
+    if not folder.strip():
+        raise click.BadParameter("FOLDER is empty; name a folder, '.' for this one",
+                                 param_hint="FOLDER")
     data = resources.files("srarap_cli") / "data"
     files = [(os.path.join(folder, sub, item.name), item.read_bytes())
              for sub in SUBFOLDERS for item in sorted(
@@ -32,11 +35,18 @@ def samples(folder: str, force: bool, quiet: bool) -> None:
     if clash and not force:
         raise OutputError(f"{clash[0]}: exists (and {len(clash) - 1} more); --force replaces "
                           "them")
+    # checked before any is made: a file in the way leaves no half-made tree behind
+    blocked = [os.path.join(folder, sub) for sub in ("", *SUBFOLDERS)
+               if os.path.exists(os.path.join(folder, sub))
+               and not os.path.isdir(os.path.join(folder, sub))]
+    if blocked:
+        raise OutputError(f"{blocked[0]}: exists and is not a folder")
     for sub in SUBFOLDERS:
         try:
             os.makedirs(os.path.join(folder, sub), exist_ok=True)
         except OSError as exc:
-            raise OutputError(f"{folder}: cannot create folder: {exc.strerror}") from None
+            raise OutputError(f"{os.path.join(folder, sub)}: cannot create folder: "
+                              f"{exc.strerror}") from None
     commit_files(files)
     if not quiet:
         click.echo(f"srarap samples: wrote {len(files)} files to {folder}", err=True)

@@ -1,9 +1,17 @@
-"""Write several output files all-or-nothing: all to temporary names, then all renamed."""
+"""Write several output files all-or-nothing: all to temporary names, then all renamed.
+
+Only regular files (new ones, or existing ones reached directly or through a symbolic link)
+are staged and renamed. A target that is not a regular file (a character device such as
+``/dev/null``, a named pipe, a terminal) or that names an open descriptor (``/dev/stdout``,
+``/proc/self/fd/N``) is written through, in place: renaming over it would replace the device
+or the pipe, which a reader (or the system) is using, with a regular file.
+"""
 import glob
 import os
 import secrets
 import shutil
 import signal
+import stat
 import tempfile
 
 from .errors import OutputError
@@ -22,12 +30,22 @@ def commit_files(files: list[tuple[str, bytes]]) -> None:
     written are they renamed over the targets (a rename within a folder is atomic). A target
     that existed is kept under a temporary name (a hard link) until every rename succeeded, so
     a rename that fails late (the target became a folder, the disk went read-only) puts back
-    what the earlier ones replaced.
+    what the earlier ones replaced. A symbolic link is followed: its target is replaced, the
+    link kept. Targets that are not regular files are written through after every regular
+    one was staged and before any is renamed, so a failed write through (``/dev/full``)
+    leaves every regular target as it was.
     """
     staged = []
     try:
+        through = []
         for path, data in files:
-            staged.append((_named(path, _stage, path, data), path))
+            if _writes_through(path):
+                through.append((path, data))
+            else:
+                target = os.path.realpath(path) if os.path.islink(path) else path
+                staged.append((_named(path, _stage, target, data), target))
+        for path, data in through:
+            _named(path, _write_through, path, data)
         # the renames and their record are one critical section: a SIGINT/SIGTERM waits
         # until both are done, so the report always matches the files on disk
         blocked = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
@@ -60,6 +78,24 @@ def _replace_all(staged):
         _remove(kept)
 
 
+def _writes_through(path):
+    """Whether ``path`` is written in place: it exists and is not a regular file or a folder
+    (device, pipe, socket), or it names a descriptor (under /dev or /proc)."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:  # nothing there yet (or unreachable: the staging reports why)
+        return False
+    if stat.S_ISDIR(mode):
+        return False
+    return not stat.S_ISREG(mode) or os.path.abspath(path).startswith(("/dev/", "/proc/"))
+
+
+def _write_through(path, data):
+    with open(path, "wb") as fh:
+        fh.write(data)
+    COMMITTED.append(path)
+
+
 def _restore(path, kept):
     try:
         if kept is None:
@@ -75,6 +111,8 @@ def _named(path, func, *args):
     temporary name)."""
     try:
         return func(*args)
+    except BrokenPipeError:  # a reader went away (``-o /dev/stdout | head``): not an error
+        raise
     except OSError as exc:
         reason = "is a folder" if isinstance(exc, IsADirectoryError) or os.path.isdir(path) \
             else f"cannot write: {exc.strerror or exc}"

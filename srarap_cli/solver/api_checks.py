@@ -14,34 +14,50 @@ def mesh_arrays(V: ArrayLike, F: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     >>> mesh_arrays([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 3]])
     Traceback (most recent call last):
     ...
-    ValueError: F: vertex index 3 out of range for V of 3 rows
+    ValueError: F: vertex index 3 out of range for 3 vertices (ids are 0-based)
     """
     V = _floats(V, "V")
     if V.ndim != 2 or V.shape[1] != 3 or not len(V):
         raise ValueError(f"V must be an (n, 3) array of vertex positions, got shape {V.shape}")
     if not np.isfinite(V).all():
         raise ValueError("V has NaN or infinite coordinates")
-    F = np.asarray(F)
+    F = _array(F, "F")
     if F.ndim != 2 or F.shape[1] != 3 or not len(F):
         raise ValueError(f"F must be an (f, 3) array of triangles, got shape {F.shape}")
     if F.dtype.kind not in "iu":
         if F.dtype.kind != "f" or not np.all(F == np.round(F)):
             raise ValueError(f"F must hold integer vertex indices, got dtype {F.dtype}")
-    F = F.astype(np.int64, copy=False)  # no copy of an int64 F: 35 MB at 738k vertices
-    if F.min() < 0 or F.max() >= len(V):
-        bad = int(F.min() if F.min() < 0 else F.max())
-        raise ValueError(f"F: vertex index {bad} out of range for V of {len(V)} rows")
-    return V, F
+    _in_range(F, len(V), "F")
+    return V, F.astype(np.int64, copy=False)  # no copy of an int64 F: 35 MB at 738k vertices
+
+
+def _in_range(ids, n, name):
+    """Refuse an index outside 0..n-1, named as given (before any cast: an unsigned 2**64-1
+    would wrap to -1)."""
+    low, high = ids.min(), ids.max()
+    if low < 0 or high >= n:
+        bad = low if low < 0 else high
+        raise ValueError(f"{name}: vertex index {int(bad) if float(bad).is_integer() else bad} "
+                         f"out of range for {n} vertices (ids are 0-based)")
+
+
+def _array(values, name):
+    """``np.asarray(values)``, a ragged nesting refused by name."""
+    try:
+        return np.asarray(values)
+    except ValueError:
+        raise ValueError(f"{name} must be a rectangular array (its rows have different "
+                         "lengths)") from None
 
 
 def vertex_ids(ids: ArrayLike, n: int, name: str = "constrained") -> np.ndarray:
     """``ids`` as a (k,) int array of distinct vertex indices below ``n``."""
-    ids = np.asarray(ids)
+    ids = _array(ids, name)
     if ids.dtype.kind not in "iu" or ids.ndim > 1:
         raise ValueError(f"{name} must be a 1-d array of integer vertex indices")
+    if ids.size:
+        _in_range(ids, n, name)
     ids = ids.astype(np.int64).ravel()
-    if ids.size and (ids.min() < 0 or ids.max() >= n):
-        raise ValueError(f"{name}: vertex index out of range for {n} vertices")
     if np.unique(ids).size != ids.size:
         raise ValueError(f"{name} lists a vertex twice")
     return ids
@@ -79,6 +95,9 @@ def initial(state: Any, n: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _floats(values, name):
+    values = _array(values, name)
+    if np.iscomplexobj(values):  # a cast to float would drop the imaginary parts in silence
+        raise ValueError(f"{name} must hold real numbers, got complex ones")
     try:
         return np.asarray(values, dtype=float)
     except (TypeError, ValueError):

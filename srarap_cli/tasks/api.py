@@ -61,7 +61,8 @@ def deform(mesh: Any, handles: Any, *arrays: Any,
         raise TypeError("deform(mesh, handles) starts cold; for a warm start use "
                         "deform(V, F, constrained, targets, initial=...) or a Deformer")
     given = keywords(options, ("setup", "solve", "build"), "deform")
-    source = mesh if isinstance(mesh, Mesh) else Mesh.from_arrays(*mesh_like(mesh))
+    arrays = mesh_like(mesh)  # checked whatever its type: a NaN is the mesh's, not a handle's
+    source = mesh if isinstance(mesh, Mesh) else Mesh.from_arrays(*arrays)
     constraints = as_constraints(handles, source.vertices)
     opts = resolve(settings or {}, constraints.solver, given)
     _, result, notes = deform_mesh(source, constraints, opts, callback=callback, cache=cache)

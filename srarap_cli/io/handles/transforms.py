@@ -34,17 +34,25 @@ def rotation_matrix(ctx: Context, spec: dict) -> np.ndarray:
     if quats:
         key = quats[0]
         order = "x, y, z, w" if key == "quaternion_xyzw" else "w, x, y, z"
-        q = ctx.vector(spec[key], f"{key} [{order}]", 4)[QUATERNION_KEYS[key]]
+        q = _scaled(ctx.vector(spec[key], f"{key} [{order}]", 4)[QUATERNION_KEYS[key]])
         if np.linalg.norm(q) < 1e-12:
             raise ctx.error(f"{key} must not be zero")
         return to_matrix(q / np.linalg.norm(q))
     if "axis" not in spec or len(angles) != 1:
         raise ctx.error("rotate needs 'axis' and one of angle_deg, angle_rad or angle (degrees)")
-    axis = ctx.vector(spec["axis"], "axis", 3)
+    axis = _scaled(ctx.vector(spec["axis"], "axis", 3))
     if np.linalg.norm(axis) < 1e-12:
         raise ctx.error("axis must not be zero")
     key = angles[0]
     return to_matrix(from_axis_angle(axis, ctx.number(spec[key], key) * ANGLE_KEYS[key]))
+
+
+def _scaled(v):
+    """``v`` divided by its largest component: only its direction counts, and the norm of a
+    vector with components above about 1e154 overflows (it made such a quaternion the
+    identity). A zero or tiny vector is left as it is, for the caller to refuse."""
+    top = float(np.abs(v).max())
+    return v / top if top > 1.0 else v
 
 
 def _matrix(ctx, value, base):

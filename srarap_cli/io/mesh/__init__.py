@@ -80,7 +80,7 @@ def frame_formatter(mesh: Mesh, suffix: str) -> Callable[[np.ndarray], bytes]:
 def format_mesh(mesh: Mesh, suffix: str, ascii: bool = False) -> tuple[bytes, list[str]]:
     """File content for ``mesh`` in the format of the extension ``suffix`` (``.obj``; a text
     variant with ``ascii`` where the format has one), with warnings for lost data."""
-    return _writable(suffix).write(mesh, ascii)
+    return _writable(suffix).encode(mesh, ascii)
 
 
 def _writable(suffix):
@@ -118,6 +118,6 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh) -> list[str]:
         suffix = os.path.splitext(str(path))[1].lower()
         raise OutputError(f"{path}: cannot write {suffix or 'files without extension'}; "
                           f"use one of {_listed()}")
-    data, lost = fmt.write(mesh, False)
+    data, lost = fmt.encode(mesh)
     atomic_write(path, data)
     return lost

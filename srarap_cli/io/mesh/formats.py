@@ -64,6 +64,15 @@ class MeshFormat:
     def extension(self) -> str:
         return self.extensions[0]
 
+    def encode(self, mesh: Mesh, ascii: bool = False) -> Written:
+        """``write``'s bytes and warnings, with a warning for what the file ``mesh`` was read
+        from held and no writer keeps (:attr:`Mesh.unkept`)."""
+        data, lost = self.write(mesh, ascii)
+        if mesh.unkept:
+            lost = lost + [f"not written: {'; '.join(mesh.unkept)} of the input (srarap "
+                           "keeps vertices, faces and per-vertex properties)"]
+        return data, lost
+
     def frame_writer(self, mesh: Mesh) -> Callable[[np.ndarray], bytes]:
         """``frame(positions) -> bytes``: the file of ``mesh`` with other positions (n, 3)."""
         if self.frames is not None:

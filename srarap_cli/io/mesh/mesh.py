@@ -22,6 +22,8 @@ class Mesh:
     vertex_data : dict of name -> (n,) array, other per-vertex properties (PLY)
     statements : list of (int, str), OBJ lines kept verbatim (``mtllib``, ``usemtl``, ``g``,
         ``s``, ...) with the number of faces that preceded them
+    unkept : list of str, what the file held that no writer keeps (PLY face properties,
+        other PLY elements): every written file warns of it
     """
 
     vertices: np.ndarray
@@ -33,6 +35,7 @@ class Mesh:
     face_normals: np.ndarray | None = None
     vertex_data: dict = field(default_factory=dict)
     statements: list = field(default_factory=list)
+    unkept: list[str] = field(default_factory=list)
 
     @classmethod
     def from_arrays(cls, V: ArrayLike, F: np.ndarray | Sequence[ArrayLike]) -> "Mesh":

@@ -65,9 +65,15 @@ def _header(data, path):
                 "ascii", "binary_little_endian", "binary_big_endian"):
             fmt = words[1]
         elif words[0] == "element" and len(words) == 3 and words[2].isdigit():
+            if any(words[1] == e[0] for e in elements):
+                raise InputError(f"{path}: PLY element {excerpt(words[1])!r} declared twice")
             elements.append((words[1], int(words[2]), []))
         elif words[0] == "property" and elements:
-            elements[-1][2].append(_property(words, path))
+            prop = _property(words, path)
+            if any(prop[0] == p[0] for p in elements[-1][2]):
+                raise InputError(f"{path}: property {excerpt(prop[0])!r} of PLY element "
+                                 f"{excerpt(elements[-1][0])!r} declared twice")
+            elements[-1][2].append(prop)
         else:
             raise InputError(f"{path}: bad PLY header line {excerpt(raw)!r}")
     if fmt is None:
@@ -259,4 +265,19 @@ def _mesh(values, elements, path):
             mesh.face_uv = mesh.face_vertices.copy()
             break
     mesh.vertex_data = data
+    mesh.unkept = _unkept(elements, lists[0])
     return mesh
+
+
+def _unkept(elements, face_list):
+    """What of the file's elements no writer keeps: face properties besides the corners,
+    and elements other than vertex and face."""
+    out = []
+    for name, count, props in elements:
+        if name == "face":
+            extra = [p for p, _ in props if p != face_list]
+            if extra:
+                out.append(f"face properties {', '.join(extra)}")
+        elif name != "vertex":
+            out.append(f"element {name!r} ({count})")
+    return out

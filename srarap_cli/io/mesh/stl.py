@@ -8,6 +8,7 @@ is vectorized (no Python loop per number). Taking STL out of meshio also keeps m
 its terminal-rendering dependencies out of the default install.
 """
 import os
+import re
 
 import numpy as np
 
@@ -52,19 +53,24 @@ def read_stl(path: str | os.PathLike) -> Mesh:
             return _welded(corners.reshape(-1, 3))
     if not data.strip():
         return _welded(np.zeros((0, 3)))
-    if not data.lstrip().startswith(b"solid"):
+    if not data.lstrip()[:5].lower() == b"solid":
         raise InputError(f"{path}: not a readable STL file (binary size does not match "
                          f"its triangle count, and it does not start with 'solid')")
     return _welded(_ascii_corners(path, data))
 
 
+_SOLID_LINE = re.compile(rb"^[ \t]*(end)?solid\b[^\n]*$", re.IGNORECASE | re.MULTILINE)
+
+
 def _ascii_corners(path, data):
-    tokens = data.split()
-    if b"endsolid" not in tokens:
-        raise InputError(f"{path}: not a readable STL file (no 'endsolid': truncated?)")
-    stop = len(tokens) - 1 - tokens[::-1].index(b"endsolid")
-    start = tokens.index(b"facet") if b"facet" in tokens[:stop] else stop
-    body = tokens[start:stop]
+    """Corners of every facet of every solid. Keywords in any case; ``solid`` and
+    ``endsolid`` lines are dropped whole, so a solid's name (even ``facet``) is never read
+    as a keyword, and several solids one after another read as one."""
+    ends = [m for m in _SOLID_LINE.finditer(data) if m.group(1)]
+    if not ends or data[ends[-1].end():].strip():
+        raise InputError(f"{path}: not a readable STL file (it does not end with 'endsolid': "
+                         "truncated?)")
+    body = _SOLID_LINE.sub(b"", data).lower().split()
     if len(body) % len(_FACET):
         whole = len(body) // len(_FACET)
         raise InputError(f"{path}: not a readable STL file (facet {whole} is incomplete or "

@@ -4,6 +4,7 @@ import os
 import tempfile
 from typing import BinaryIO
 
+from ...runtime import descriptors
 from ...runtime.errors import InputError
 from ...runtime.limits import available_memory, check_read_size
 from .formats import FORMATS, HEAD_BYTES, MeshFormat, by_content
@@ -23,7 +24,7 @@ def read_mesh_stream(stream: BinaryIO | None, fmt: MeshFormat | None = None,
     memory any format needs per byte). A closed stream, an empty one, content of no known
     format and a temporary folder that cannot take the bytes are InputErrors naming ``name``.
     """
-    if stream is None:
+    if stream is None or descriptors.closed(0):
         raise InputError(f"{name}: standard input is closed; give a mesh file instead of '-'")
     have = available_memory()
     factor = fmt.read_factor if fmt else min(f.read_factor for f in FORMATS.values())

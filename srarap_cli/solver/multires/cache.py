@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...runtime.commit import atomic_write
-from ...runtime.errors import OutputError
+from ...runtime.errors import OutputError, excerpt
 from .simplify import CoarseMesh, simplify_to_subset
 
 #: Names the entry layout and the simplifier's behaviour: change it when either changes.
@@ -57,7 +57,10 @@ def coarse_mesh(V: np.ndarray, F: np.ndarray, size: int, groups: list[np.ndarray
                  warnings=np.array(coarse.warnings, dtype=str))
         atomic_write(path, buf.getvalue())
     except (OSError, OutputError) as exc:
-        notes.append(f"{cache_dir}: cannot write the cache ({exc})")
+        notes.append(f"{excerpt(cache_dir, 80)}: cannot write the cache ({excerpt(exc, 120)})")
+    except RecursionError:  # os.makedirs recurses once per missing folder level
+        notes.append(f"{excerpt(cache_dir, 80)}: cannot write the cache (too many folder "
+                     "levels)")
     return coarse, False, notes
 
 
