@@ -15,22 +15,39 @@ def main() -> None:
     signals.own()
     code = 1
     try:
+        code = _run()
+    finally:  # a signal anywhere in the run or its handlers below still ends here
+        _leave(code)
+
+
+def _run() -> int:
+    try:
         from .cli import main as command
         command(prog_name="srarap")
-        code = 0
+        return 0
     except SystemExit as exc:
-        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
         if not isinstance(exc.code, (int, type(None))):
             sys.stderr.write(f"{exc.code}\n")
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
     except KeyboardInterrupt:
         signals.streams.release()
         sys.stderr.write(f"srarap: error: interrupted; {_written()}\n")
-        code = 130
+        return 130
     except signals.Terminated:
         signals.streams.release()
         sys.stderr.write(f"srarap: error: terminated; {_written()}\n")
-        code = 143
-    signals.exit_now(code, lambda word: f"{word}; {_written()}")
+        return 143
+
+
+def _leave(code: int) -> None:
+    """The process's one way out. A signal that lands on the way (after the summary line,
+    say) is not a crash: it is recorded, and the exit reports it with its code (see
+    :func:`srarap_cli.runtime.signals.exit_now`)."""
+    for _ in range(3):
+        try:
+            signals.exit_now(code, lambda word: f"{word}; {_written()}")
+        except BaseException:  # the signal that raised is recorded: leave again
+            code = 1
 
 
 def _written():

@@ -51,9 +51,13 @@ class LazyGroup(click.Group):
         if name not in COMMANDS:
             return None
         module, attr, _ = COMMANDS[name]
-        # imports numpy: here, after main's BLAS thread settings, and not for ``srarap --help``
-        defer_unused_numpy_modules()
-        return getattr(importlib.import_module(f".{module}", __name__), attr)
+        # imports numpy: here, after main's BLAS thread settings, and not for ``srarap --help``;
+        # with SIGINT/SIGTERM held back, since one raised inside numpy's class set-up surfaced
+        # as a RuntimeError: it is raised once the imports are done
+        with signals.deferred():
+            defer_unused_numpy_modules()
+            found = getattr(importlib.import_module(f".{module}", __name__), attr)
+        return found
 
     def main(self, args: Sequence[str] | None = None, prog_name: str | None = None,  # type: ignore[override]
              complete_var: str | None = None, standalone_mode: bool = True,

@@ -10,7 +10,14 @@ import click
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..runtime.errors import OutputError
-from ..tasks.batch import SUMMARY_FIELDS, check_outputs, load_manifest, run_batch
+from ..runtime.signals import Terminated
+from ..tasks.batch import (
+    SUMMARY_FIELDS,
+    BatchInterrupted,
+    check_outputs,
+    load_manifest,
+    run_batch,
+)
 from .common import guarded
 
 #: a Dask scheduler address: protocol://host:port, or host:port
@@ -50,23 +57,33 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         os.makedirs(out, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
-    rows = run_batch(jobs, out, workers, scheduler, keep_unconverged)
+    try:
+        rows, stopped = run_batch(jobs, out, workers, scheduler, keep_unconverged), None
+    except BatchInterrupted as exc:  # the workers are stopped: say what finished
+        rows, stopped = exc.rows, exc.signal
     commit_files([(os.path.join(out, "summary.csv"), _csv(rows).encode()),
                   (os.path.join(out, "summary.json"), (json.dumps(rows, indent=2) + "\n").encode())])
     counts = {s: sum(r["status"] == s for r in rows) for s in
-              ("ok", "up-to-date", "not-converged", "regressed", "failed")}
-    if not quiet:
-        for r in rows:
+              ("ok", "up-to-date", "not-converged", "regressed", "failed", "interrupted")}
+    if not quiet or stopped is not None:
+        for r in rows if not quiet else ():
             extra = f"  {r['message']}" if r["message"] else ""
-            click.echo(f"{r['job']:24} {r['status']:13} {r['seconds']:8.2f} s{extra}", err=True)
+            seconds = "" if r["seconds"] is None else f"{r['seconds']:8.2f} s"
+            click.echo(f"{r['job']:24} {r['status']:13} {seconds:>10}{extra}", err=True)
         summary = ", ".join(f"{v} {k}" for k, v in counts.items() if v)
         note = " (nothing to solve: all up to date)" if counts["up-to-date"] == len(rows) else ""
+        if stopped is not None:
+            word = "terminated" if isinstance(stopped, Terminated) else "interrupted"
+            note = (f"; {word}: the jobs not finished are marked interrupted in "
+                    f"{os.path.join(out, 'summary.csv')}")
         click.echo(f"srarap batch: {len(rows)} jobs: {summary}{note}", err=True)
+    if stopped is not None:
+        raise SystemExit(exit_codes.TERMINATED if isinstance(stopped, Terminated)
+                         else exit_codes.INTERRUPTED)
     if counts["failed"] or counts["regressed"]:
         raise SystemExit(exit_codes.BATCH_FAILED)
     if counts["not-converged"]:
         raise SystemExit(exit_codes.NOT_CONVERGED)
-
 
 def _csv(rows):
     buf = io.StringIO()

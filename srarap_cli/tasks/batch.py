@@ -21,6 +21,7 @@ import hashlib
 import json
 import math
 import os
+import signal
 import time
 from concurrent.futures import ProcessPoolExecutor
 from importlib import metadata
@@ -34,6 +35,7 @@ from ..io.mesh.formats import extensions
 from ..runtime.commit import commit_files
 from ..runtime.errors import InputError, NumericalError, excerpt
 from ..runtime.paths import refuse_overwriting_inputs
+from ..runtime.signals import Terminated
 from ..solver.settings import parse_mapping, resolve
 from ..solver.stop import StopReason
 from .compare import compare_meshes
@@ -230,9 +232,88 @@ def run_batch(jobs: list[Job],
     if scheduler is not None:
         return _run_on_dask(jobs, run, scheduler, workers)
     if workers <= 1:
-        return [run(job) for job in jobs]
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(run, jobs))
+        rows: list[Row] = []
+        try:
+            for job in jobs:
+                rows.append(run(job))
+        except (KeyboardInterrupt, Terminated) as exc:
+            raise BatchInterrupted(rows + [interrupted_row(j) for j in jobs[len(rows):]],
+                                   exc) from None
+        return rows
+    return _run_in_processes(jobs, run, workers)
+
+
+class BatchInterrupted(BaseException):
+    """SIGINT or SIGTERM stopped a batch: ``rows`` are the summary rows, in manifest order,
+    of the jobs that finished and of the others (``status`` ``interrupted``); ``signal`` the
+    exception the signal raised."""
+
+    def __init__(self, rows: list[Row], signal: BaseException) -> None:
+        super().__init__("interrupted")
+        self.rows, self.signal = rows, signal
+
+
+def interrupted_row(job: Job) -> Row:
+    """The summary row of a job a signal stopped before it finished."""
+    return {"job": job["name"], "status": "interrupted", "stop": "", "iterations": None,
+            "energy": None, "seconds": None, "compare_max": None,
+            "message": "not finished: the batch was interrupted"}
+
+
+#: seconds the workers get to stop after SIGTERM before they are killed
+STOP_GRACE = 2.0
+
+
+def _run_in_processes(jobs, run, workers):
+    """Jobs in ``workers`` processes, rows in manifest order. A signal to this process
+    stops the workers (SIGTERM, then SIGKILL after :data:`STOP_GRACE` seconds), keeps the
+    rows of the jobs that finished and raises :class:`BatchInterrupted`."""
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
+    futures = []
+    try:
+        futures = [pool.submit(_in_worker, run, job) for job in jobs]
+        rows = [f.result() for f in futures]
+    except (KeyboardInterrupt, Terminated) as exc:
+        _stop(pool)
+        finished = {k: f.result() for k, f in enumerate(futures)
+                    if f.done() and not f.cancelled() and f.exception() is None}
+        raise BatchInterrupted([finished.get(k) or interrupted_row(job)
+                                for k, job in enumerate(jobs)], exc) from None
+    pool.shutdown()
+    return rows
+
+
+def _worker_signals():
+    """A worker leaves SIGINT to the batch (a terminal's Ctrl-C reaches the whole group: the
+    batch stops the workers and reports); SIGTERM, from the batch, ends it once its
+    cleanup (temporary files) has run."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, _terminated)
+
+
+def _terminated(_signum, _frame):
+    raise Terminated()
+
+
+def _in_worker(run, job):
+    try:
+        return run(job)
+    except Terminated:  # the batch stops: leave without the pool's report of it
+        os._exit(143)
+
+
+def _stop(pool):
+    processes = list(getattr(pool, "_processes", {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in processes:
+        if p.is_alive():
+            p.terminate()
+    deadline = time.monotonic() + STOP_GRACE
+    for p in processes:
+        p.join(max(deadline - time.monotonic(), 0.0))
+        if p.is_alive():
+            p.kill()
+            p.join(1.0)
 
 
 #: what srarap's own Dask workers get instead of Dask's defaults: one BLAS thread, and glibc's
@@ -266,7 +347,8 @@ def _run_on_dask(jobs, run, scheduler, workers):
     cluster = None
     if scheduler == "local":
         # the workers are forked while the cluster starts: they keep these settings
-        with dask.config.set(LOCAL_CONFIG), _without_dasks_trim_setting():
+        with dask.config.set(LOCAL_CONFIG), _without_dasks_trim_setting(), \
+                _workers_leave_sigint_to_the_batch():
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None)
     try:
@@ -292,7 +374,50 @@ def _without_dasks_trim_setting():
             os.environ["MALLOC_TRIM_THRESHOLD_"] = value
 
 
+#: set while a local cluster forks its workers (see :func:`_dask_worker_signals`)
+_FORKING_DASK_WORKERS = False
+
+
+@contextlib.contextmanager
+def _workers_leave_sigint_to_the_batch():
+    """While the cluster starts, the workers it forks leave SIGINT to the batch (a
+    terminal's Ctrl-C reaches the whole group) and die of SIGTERM (how their nanny stops
+    them): with srarap's handlers, inherited through the fork, each printed a traceback
+    from its event loop."""
+    global _FORKING_DASK_WORKERS
+    _FORKING_DASK_WORKERS = True
+    try:
+        yield
+    finally:
+        _FORKING_DASK_WORKERS = False
+
+
+def _dask_worker_signals():
+    if _FORKING_DASK_WORKERS:  # in the child, just forked: its only thread is the main one
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+os.register_at_fork(after_in_child=_dask_worker_signals)
+
+
+def _silence_dask():
+    """Dask's and asyncio's log lines while a cluster is stopped early (cancelled tasks,
+    lost workers, the interrupted gather's tasks collected later) are not the user's
+    concern: the summary says what finished. For the rest of the process, which is ending."""
+    import logging
+    for name in ("distributed", "asyncio"):
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+
+
 def _gather(client, jobs, run):
     with client:
         futures = client.map(run, jobs, pure=False)
-        return client.gather(futures)
+        try:
+            return client.gather(futures)
+        except (KeyboardInterrupt, Terminated) as exc:
+            _silence_dask()
+            rows = [f.result() if f.status == "finished" else interrupted_row(job)
+                    for f, job in zip(futures, jobs)]
+            client.cancel(futures)
+            raise BatchInterrupted(rows, exc) from None

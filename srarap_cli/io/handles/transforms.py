@@ -50,9 +50,10 @@ def rotation_matrix(ctx: Context, spec: dict) -> np.ndarray:
 def _scaled(v):
     """``v`` divided by its largest component: only its direction counts, and the norm of a
     vector with components above about 1e154 overflows (it made such a quaternion the
-    identity). A zero or tiny vector is left as it is, for the caller to refuse."""
+    identity), below about 1e-154 underflows. A zero vector is left as it is, for the
+    caller to refuse."""
     top = float(np.abs(v).max())
-    return v / top if top > 1.0 else v
+    return v / top if top > 0 else v
 
 
 def _matrix(ctx, value, base):

@@ -98,12 +98,20 @@ def _read_general(path):
     if corners.size != sizes.sum() or (sizes < 3).any():
         raise InputError(f"{path}: a face line lists fewer indices than its corner count")
     mesh = Mesh(vertices=V, face_sizes=sizes, face_vertices=corners)
-    if "N" in prefix:
-        mesh.normals = np.array([r[3:6] for r in vrows], dtype=float)
-        mesh.face_normals = corners.copy()
-    if "ST" in prefix:
-        mesh.uv = np.array([r[-2:] for r in vrows], dtype=float)
-        mesh.face_uv = corners.copy()
+    need = 3 + 3 * ("N" in prefix) + 2 * ("ST" in prefix)
+    short = next((k for k, r in enumerate(vrows) if len(r) < need), None)
+    if short is not None:
+        raise InputError(f"{path}: vertex {short} has {len(vrows[short])} numbers; a "
+                         f"{excerpt(header[0], 20)} vertex needs {need}")
+    try:
+        if "N" in prefix:
+            mesh.normals = np.array([r[3:6] for r in vrows], dtype=float)
+            mesh.face_normals = corners.copy()
+        if "ST" in prefix:
+            mesh.uv = np.array([r[-2:] for r in vrows], dtype=float)
+            mesh.face_uv = corners.copy()
+    except (ValueError, OverflowError):
+        raise InputError(f"{path}: non-numeric vertex normal or texture coordinate") from None
     return mesh
 
 

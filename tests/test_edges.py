@@ -1,0 +1,318 @@
+"""The edges of the command line, by class, on generated variants: outputs that are not
+regular files, closed standard descriptors, standard input of any content and size, PLY
+property tables, extreme quaternions, signals to a batch. ``SRARAP_EDGE_EXAMPLES`` sets the
+budget of the cheap generators (default 40; a run of 20,000 is reported in the issue's
+closing note)."""
+import json
+import os
+import signal
+import stat
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+import yaml
+from click.testing import CliRunner
+from helpers import ROOT, tube_mesh
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from srarap_cli.cli import main
+from srarap_cli.io.mesh import format_mesh
+from srarap_cli.solver.quaternion import to_matrix
+
+BUDGET = int(os.environ.get("SRARAP_EDGE_EXAMPLES", "40"))
+DOCUMENTED = {0, 2, 3, 4, 5, 6, 7, 8, 130, 141, 143}
+MESH = tube_mesh(rings=3, segments=4)
+TWIST = {"groups": {"base": {"box": {"min": [-2, -2, -0.01], "max": [2, 2, 0.01]},
+                             "fixed": True},
+                    "top": {"box": {"min": [-2, -2, 5.99], "max": [2, 2, 6.01]},
+                            "rotate": {"axis": [0, 0, 1], "angle_deg": 30}}}}
+cheap = settings(max_examples=BUDGET, deadline=None,
+                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+
+
+@pytest.fixture(scope="module")
+def case(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("edges")
+    (folder / "m.obj").write_bytes(format_mesh(MESH, ".obj")[0])
+    (folder / "h.yaml").write_text(yaml.safe_dump(TWIST))
+    ref = CliRunner().invoke(main, ["deform", str(folder / "m.obj"), str(folder / "h.yaml"),
+                                    "-o", str(folder / "ref.obj"), "--log",
+                                    str(folder / "ref.csv"), "-q"])
+    assert ref.exit_code == 0, ref.output
+    return folder
+
+
+def _srarap(*args, cwd, stdin=None, shell_prefix=""):
+    """The console command in a subprocess (``shell_prefix``: redirections such as '2>&-')."""
+    line = " ".join(f"'{a}'" for a in args)
+    return subprocess.run(f"exec {sys.executable} -m srarap_cli {line} {shell_prefix}",
+                          shell=True, cwd=cwd, input=stdin, capture_output=True, timeout=300)
+
+
+# --- outputs that are not regular files are written through, never replaced --------------
+
+def _special(folder, kind, name):
+    path = folder / name
+    if path.exists() or path.is_symlink():
+        path.unlink()
+    if kind == "device":
+        try:
+            os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, 3))  # /dev/null's numbers
+        except PermissionError:
+            pytest.skip("making a character device needs root (CI runs as root)")
+    elif kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "symlink":
+        (folder / f"real-{name}").write_text("old")
+        path.symlink_to(folder / f"real-{name}")
+    return path
+
+
+@pytest.mark.parametrize("kind", ["device", "fifo", "symlink"])
+@pytest.mark.parametrize("which", ["-o", "--log"])
+def test_an_output_that_is_not_a_regular_file_is_written_through(case, kind, which):
+    name = "out.obj" if which == "-o" else "out.csv"
+    target = _special(case, kind, name)
+    got = []
+    if kind == "fifo":  # a reader, as a pipeline's next command would be
+        reader = threading.Thread(target=lambda: got.append(open(target, "rb").read()))
+        reader.start()
+    other = ["--log", str(case / "x.csv")] if which == "-o" else ["-o", str(case / "x.obj")]
+    r = CliRunner().invoke(main, ["deform", str(case / "m.obj"), str(case / "h.yaml"),
+                                  which, str(target), *other, "-q"])
+    assert r.exit_code == 0, r.output
+    mode = os.lstat(target).st_mode
+    assert {"device": stat.S_ISCHR, "fifo": stat.S_ISFIFO, "symlink": stat.S_ISLNK}[kind](mode)
+    if kind == "fifo":
+        reader.join(60)
+        written = got[0]
+    elif kind == "symlink":
+        written = (case / f"real-{name}").read_bytes()
+    else:
+        return  # the null device keeps nothing; it is still the device
+    if which == "-o":
+        assert written == (case / "ref.obj").read_bytes()
+    else:  # the log's seconds differ from run to run: its rows and columns do not
+        ref = (case / "ref.csv").read_text().splitlines()
+        rows = written.decode().splitlines()
+        assert rows[0] == ref[0] and len(rows) == len(ref)
+
+
+def test_dev_stdout_is_written_through_with_a_format(case):
+    p = _srarap("deform", "m.obj", "h.yaml", "-o", "/dev/stdout", "--format", "obj", "-q",
+                cwd=case)
+    assert p.returncode == 0 and p.stdout == (case / "ref.obj").read_bytes()
+
+
+# --- closed standard descriptors ---------------------------------------------------------
+
+@settings(max_examples=max(BUDGET // 40, 8), deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(closed=st.sets(st.sampled_from([0, 1, 2]), min_size=1),
+       command=st.sampled_from(["deform-file", "deform-stdout", "deform-stdin", "info"]))
+def test_closed_standard_descriptors(case, closed, command):
+    """A closed stream is no error of the run: a solve to a file succeeds and writes its mesh
+    whole; '-' on a closed stream is refused by name (4 reading, 6 writing), nothing written."""
+    redirect = " ".join(f"{fd}>&-" if fd else "<&-" for fd in sorted(closed))
+    out = case / f"closed-{command}.obj"
+    if out.exists():
+        out.unlink()
+    args = {"deform-file": ["deform", "m.obj", "h.yaml", "-o", out.name],
+            "deform-stdout": ["deform", "m.obj", "h.yaml", "-o", "-"],
+            "deform-stdin": ["deform", "-", "h.yaml", "-o", out.name],
+            "info": ["info", "m.obj", "h.yaml"]}[command]
+    p = _srarap(*args, cwd=case, shell_prefix=redirect)
+    assert b"Traceback" not in p.stderr and p.returncode in DOCUMENTED
+    if command == "deform-file" or command == "info":
+        assert p.returncode == 0, p.stderr
+    if command == "deform-file":
+        assert out.read_bytes() == (case / "ref.obj").read_bytes()
+    if command == "deform-stdout" and 1 in closed:
+        assert p.returncode == 6
+    if command == "deform-stdin" and 0 in closed:
+        assert p.returncode == 4 and not out.exists()
+
+
+def test_standard_output_that_fills_up_changes_no_other_output(case):
+    (case / "keep.csv").write_text("old")
+    p = _srarap("deform", "m.obj", "h.yaml", "-o", "-", "--log", "keep.csv", cwd=case,
+                shell_prefix="> /dev/full")
+    assert p.returncode == 6 and (case / "keep.csv").read_text() == "old"
+
+
+# --- standard input: any bytes, any size --------------------------------------------------
+
+FORMATS = {name: format_mesh(MESH, ext)[0] for name, ext in
+           (("obj", ".obj"), ("off", ".off"), ("ply", ".ply"), ("stl", ".stl"))}
+
+
+@st.composite
+def stdin_bytes(draw):
+    kind = draw(st.sampled_from(["mesh", "cut", "noise", "prefix"]))
+    data = FORMATS[draw(st.sampled_from(sorted(FORMATS)))]
+    if kind == "cut":
+        return data[:draw(st.integers(0, len(data)))]
+    if kind == "noise":
+        return draw(st.binary(max_size=300))
+    if kind == "prefix":
+        return draw(st.binary(max_size=20)) + data
+    return data
+
+
+@cheap
+@given(data=stdin_bytes())
+def test_standard_input_of_any_content_is_a_mesh_or_one_line(case, data):
+    r = CliRunner().invoke(main, ["deform", "-", str(case / "h.yaml"), "-o", "-", "-q"],
+                           input=data)
+    assert r.exit_code in DOCUMENTED and "Traceback" not in r.output, r.output
+    if r.exit_code not in (0, 3):
+        assert r.stdout_bytes == b"" and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_unbounded_standard_input_is_stopped_by_the_memory_guard(case):
+    """/dev/zero never ends: the guard stops the read once parsing it would not fit."""
+    env = {**os.environ, "SRARAP_MEMORY_LIMIT": "200000000"}
+    start = time.monotonic()
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", "info", "-", "--input-format",
+                        "obj"], stdin=open("/dev/zero", "rb"), capture_output=True, env=env,
+                       timeout=120, cwd=case)
+    assert p.returncode == 4 and b"<stdin>: reading it needs about" in p.stderr
+    assert time.monotonic() - start < 60
+
+
+# --- PLY property tables -----------------------------------------------------------------
+
+PLY_TYPES = ["float", "double", "int", "uchar", "short", "float32", "int32"]
+
+
+@st.composite
+def ply_tables(draw):
+    """A PLY of the tube with a generated vertex property table: x, y, z in any order among
+    extra properties, sometimes one declared twice; ASCII or binary."""
+    names = ["x", "y", "z"] + draw(st.lists(st.sampled_from(["nx", "s", "t", "w", "x", "q"]),
+                                            max_size=3))
+    names = draw(st.permutations(names))
+    types = [draw(st.sampled_from(PLY_TYPES)) for _ in names]
+    ascii_ = draw(st.booleans())
+    V, F = MESH.vertices, MESH.triangles()[0]
+    head = ["ply", f"format {'ascii' if ascii_ else 'binary_little_endian'} 1.0",
+            f"element vertex {len(V)}"]
+    head += [f"property {t} {n}" for t, n in zip(types, names)]
+    head += [f"element face {len(F)}", "property list uchar int vertex_indices", "end_header"]
+    column = {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2]}
+    values = [column.get(n, np.full(len(V), 1.0)) for n in names]
+    codes = {"float": "<f4", "float32": "<f4", "double": "<f8", "int": "<i4", "int32": "<i4",
+             "uchar": "u1", "short": "<i2"}
+    if ascii_:
+        rows = [" ".join(repr(float(c[k])) if codes[t][1] == "f" else str(int(c[k]))
+                         for c, t in zip(values, types)) for k in range(len(V))]
+        faces = [f"3 {a} {b} {c}" for a, b, c in F]
+        body = ("\n".join(rows + faces) + "\n").encode()
+    else:
+        table = np.empty(len(V), dtype=[(f"c{i}", codes[t]) for i, t in enumerate(types)])
+        for i, c in enumerate(values):
+            table[f"c{i}"] = c
+        face = np.empty(len(F), dtype=[("n", "u1"), ("v", "<i4", 3)])
+        face["n"], face["v"] = 3, F
+        body = table.tobytes() + face.tobytes()
+    return ("\n".join(head) + "\n").encode() + body, names
+
+
+@cheap
+@given(table=ply_tables())
+def test_ply_property_tables_are_read_or_refused_by_name(case, table, tmp_path_factory):
+    data, names = table
+    path = tmp_path_factory.mktemp("ply") / "m.ply"
+    path.write_bytes(data)
+    r = CliRunner().invoke(main, ["info", str(path)])
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        assert r.exit_code == 4 and f"property {twice[0]!r}" in r.output or \
+            any(f"property {n!r}" in r.output for n in twice), r.output
+    else:
+        assert r.exit_code == 0, r.output
+
+
+# --- extreme quaternions -----------------------------------------------------------------
+
+def _angle_about(q):
+    """Degrees of the rotation of quaternion q (any scale), computed apart from srarap:
+    from the rotation matrix of q scaled into range with Python's own arithmetic."""
+    top = max(abs(c) for c in q)
+    w, x, y, z = (c / top for c in q)
+    n = (w * w + x * x + y * y + z * z) ** 0.5
+    R = to_matrix(np.array([w, x, y, z]) / n)
+    return float(np.degrees(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))))
+
+
+@cheap
+@given(direction=st.lists(st.floats(-1, 1, allow_nan=False), min_size=4, max_size=4),
+       exponent=st.integers(-300, 300))
+def test_a_quaternion_of_any_scale_is_the_rotation_it_points_at(case, direction, exponent,
+                                                               tmp_path_factory):
+    q = [c * 10.0 ** exponent for c in direction]
+    doc = {"groups": {"base": TWIST["groups"]["base"],
+                      "top": {"box": TWIST["groups"]["top"]["box"],
+                              "rotate": {"quaternion_wxyz": q}}}}
+    path = tmp_path_factory.mktemp("q") / "h.json"
+    path.write_text(json.dumps(doc))
+    r = CliRunner().invoke(main, ["info", str(case / "m.obj"), str(path), "--json"])
+    if not any(q):
+        assert r.exit_code == 4 and "must not be zero" in r.output
+        return
+    assert r.exit_code == 0, r.output
+    action = json.loads(r.stdout)["groups"][1]["action"]
+    angle = _angle_about(q)
+    if action == "fixed":
+        assert angle < 1e-6, (q, angle)
+    else:
+        said = float(action.split()[1])
+        assert action.startswith("rotate ") and abs(said - angle) < 1e-4 * max(angle, 1.0), \
+            (action, angle)
+
+
+# --- signals to a batch ------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def slow_batch(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("batchsig")
+    jobs = [{"name": f"j{i}", "mesh": f"{ROOT}/sample_meshes/spot.obj",
+             "handles": f"{ROOT}/configs/spot-nod.yaml", "output": f"o{i}.obj",
+             "settings": {"tol": 0, "max_iter": 300 + i}} for i in range(6)]
+    (folder / "jobs.yaml").write_text(yaml.safe_dump({"jobs": jobs}))
+    return folder
+
+
+@pytest.mark.slow
+@settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                  HealthCheck.function_scoped_fixture])
+@given(signum=st.sampled_from([signal.SIGINT, signal.SIGTERM]),
+       delay=st.floats(0.3, 4.0), extra=st.sampled_from([[], ["--scheduler", "local"]]))
+def test_a_signal_stops_a_batch_within_seconds_with_a_true_summary(slow_batch, signum, delay,
+                                                                  extra):
+    out = slow_batch / f"out-{time.monotonic_ns()}"  # a fresh folder: nothing up to date
+    p = subprocess.Popen([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o",
+                          str(out), "--workers", "2", *extra], cwd=slow_batch,
+                         stderr=subprocess.PIPE, start_new_session=True)
+    time.sleep(delay)
+    os.killpg(p.pid, signum)  # the whole group, as a terminal's Ctrl-C
+    sent = time.monotonic()
+    _, err = p.communicate(timeout=60)
+    took = time.monotonic() - sent
+    code = {signal.SIGINT: 130, signal.SIGTERM: 143}[signum]
+    assert p.returncode == code and took < 10 and b"Traceback" not in err, err.decode()[-800:]
+    if (out / "summary.json").exists():  # a signal before the jobs were read writes none
+        rows = json.loads((out / "summary.json").read_text())
+        assert {r["status"] for r in rows} <= {"ok", "interrupted"}
+        assert all((out / f"o{r['job'][1:]}.obj").exists() for r in rows if r["status"] == "ok")
+    for _ in range(50):  # workers a starting cluster forked after the signal end too
+        left = subprocess.run(["pgrep", "-g", str(p.pid)], capture_output=True).stdout
+        if not left:
+            break
+        time.sleep(0.1)
+    assert left == b"", "processes left behind"
