@@ -1,13 +1,24 @@
 """The console entry point: signal handling first, then the command line, then one way out.
 
-Handlers are installed before anything else is imported, so that SIGINT or SIGTERM while
-Python is still loading modules ends the run with one line and the documented code. The
-process ends through :func:`srarap_cli.runtime.signals.exit_now`: no interpreter teardown, so
-neither a background thread nor a late signal can turn a finished run into a crash.
+SIGINT and SIGTERM are held back from this module's first line until srarap's handlers are
+installed, so that one arriving while Python still loads srarap's modules ends the run with
+one line and the documented code (only the interpreter's own start, before this line, is
+Python's). The process ends through :func:`srarap_cli.runtime.signals.exit_now`: no
+interpreter teardown, so neither a background thread nor a late signal can turn a finished
+run into a crash.
 """
+import _signal  # the C module: ``signal`` itself takes milliseconds to import (enum)
 import sys
 
-from .runtime import clock, descriptors, signals  # noqa: F401 -- the clock starts with the process
+# only in the ``srarap`` process itself (console script or ``python -m srarap_cli``): a
+# program that imports this module (a test runner collecting it) keeps its signals
+_HOLD = {_signal.SIGINT, _signal.SIGTERM} if getattr(sys, "argv", [""])[0].endswith(
+    ("srarap", "__main__.py")) else set()
+_signal.pthread_sigmask(_signal.SIG_BLOCK, _HOLD)
+
+import signal  # noqa: E402 -- after the signals are held
+
+from .runtime import clock, descriptors, signals  # noqa: E402, F401 -- the clock starts here
 
 
 def main() -> None:
@@ -22,6 +33,7 @@ def main() -> None:
 
 def _run() -> int:
     try:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _HOLD)  # one that came is raised here
         from .cli import main as command
         command(prog_name="srarap")
         return 0

@@ -316,3 +316,35 @@ def test_a_signal_stops_a_batch_within_seconds_with_a_true_summary(slow_batch, s
             break
         time.sleep(0.1)
     assert left == b"", "processes left behind"
+
+
+# --- a signal at any moment of a run's start and end -------------------------------------
+
+@settings(max_examples=max(BUDGET // 4, 10), deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(signum=st.sampled_from([signal.SIGINT, signal.SIGTERM]), delay=st.floats(0.0, 1.5))
+def test_a_signal_at_any_moment_is_one_line_and_its_code(case, signum, delay):
+    """While modules load (numpy's class set-up took a SIGINT as a RuntimeError), during the
+    solve, or after the summary line on the way out: exit 130/143 with one line, or 0 when
+    the run had ended; never a traceback, never exit 1. A signal during the interpreter's
+    own start, before srarap's entry module runs its first line (which holds the signals back
+    until srarap's handlers are in), is Python's: its traceback then shows no srarap module
+    but the package's ``__init__`` or the line of ``__main__`` that imports the entry, and
+    nothing is written."""
+    out = case / f"sig-{time.monotonic_ns()}.obj"
+    p = subprocess.Popen([sys.executable, "-m", "srarap_cli", "deform", "m.obj", "h.yaml",
+                          "-o", str(out)], cwd=case, stderr=subprocess.PIPE)
+    time.sleep(delay)
+    p.send_signal(signum)
+    _, err = p.communicate(timeout=120)
+    code = {signal.SIGINT: 130, signal.SIGTERM: 143}[signum]
+    if p.returncode in (1, -signum):  # the interpreter's start
+        frames = [line for line in err.decode().splitlines() if "/srarap_cli/" in line
+                  and line.strip().startswith("File")]
+        assert all("srarap_cli/__init__.py" in f or "srarap_cli/__main__.py" in f
+                   for f in frames) and not out.exists(), \
+            err.decode()[-800:]
+        return
+    assert p.returncode in (0, code) and b"Traceback" not in err, err.decode()[-600:]
+    if p.returncode == code:
+        assert err.count(b"srarap: error:") == 1
