@@ -145,3 +145,21 @@ def test_malformed_yaml_reports_the_line(tmp_path):
     path.write_text("groups:\n  a: {indices: [0\n")
     with pytest.raises(InputError, match=r"h.yaml: not valid YAML \(line \d+\)"):
         load_handles(str(path), V)
+
+
+@pytest.mark.parametrize("doc, message", [
+    ({"groups": {"a": {"indices": [0], "fixd": True}}},
+     "unknown key 'fixd' in the group; did you mean 'fixed'?"),
+    ({"solver": {"multires_mod": "transfer"}, "groups": {"a": {"indices": [0], "fixed": True}}},
+     "unknown key 'multires_mod' in solver; did you mean 'multires_mode'?"),
+])
+def test_an_unknown_key_suggests_the_nearest_one(tmp_path, doc, message):
+    with pytest.raises(InputError, match=message.replace("?", r"\?")):
+        load(tmp_path, doc)
+
+
+def test_an_index_out_of_range_gives_the_valid_range(tmp_path):
+    n = len(V)
+    with pytest.raises(InputError, match=rf"vertex {n + 5} \(and 1 more\) out of range: the "
+                                         rf"mesh has {n} vertices, ids 0..{n - 1} \(0-based\)"):
+        load(tmp_path, {"groups": {"a": {"indices": [0, n + 5, -1], "fixed": True}}})

@@ -1,4 +1,6 @@
 """Error types the CLI maps to exit codes; each message is one line naming file and field."""
+import difflib
+from collections.abc import Iterable
 
 
 class InputError(ValueError):
@@ -15,6 +17,20 @@ class NumericalError(RuntimeError):
 
 class SingularSystemError(RuntimeError):
     """A factorization met a singular matrix (for example a part with no constraint)."""
+
+
+def unknown_key(key: object, allowed: Iterable[str], where: str) -> str:
+    """The message for a key ``where`` does not take, with the nearest allowed key as a hint.
+
+    Examples
+    --------
+    >>> unknown_key("fixd", ["fixed", "box", "rotate"], "group 'base'")
+    "unknown key 'fixd' in group 'base'; did you mean 'fixed'? (allowed: box, fixed, rotate)"
+    """
+    allowed = sorted(allowed)
+    close = difflib.get_close_matches(str(key), allowed, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return f"unknown key {excerpt(key)!r} in {where}{hint} (allowed: {', '.join(allowed)})"
 
 
 def excerpt(text: object, limit: int = 40) -> str:

@@ -15,6 +15,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from ..runtime.errors import unknown_key
 from .local_step import METHODS
 from .multires.size import AUTO_RATIO, AUTO_SIZE, AUTO_THRESHOLD, parse_size
 
@@ -244,8 +245,7 @@ def parse_mapping(spec: Any, name: str, error: Callable[[str], Exception]) -> di
         raise error(f"{name} must be a mapping of {', '.join(NAMES)}")
     unknown = sorted(set(map(str, spec)) - set(NAMES))
     if unknown:
-        raise error(f"unknown key {unknown[0]!r} in {name} "
-                    f"(allowed: {', '.join(sorted(NAMES))})")
+        raise error(unknown_key(unknown[0], NAMES, name))
     return {key: BY_NAME[key].parse(value, error) for key, value in spec.items()}
 
 

@@ -4,7 +4,7 @@ from typing import Any
 
 import numpy as np
 
-from ...runtime.errors import InputError, excerpt
+from ...runtime.errors import InputError, unknown_key
 
 #: Largest integer a handle file may hold (vertex ids and counts fit in int64 with room).
 MAX_INT = 2 ** 53
@@ -29,8 +29,7 @@ class Context:
             raise self.error(f"{name} must be a mapping of keys to values")
         unknown = sorted(set(map(str, value)) - set(allowed))
         if unknown:
-            raise self.error(f"unknown key {excerpt(unknown[0])!r} in {name} "
-                             f"(allowed: {', '.join(sorted(allowed))})")
+            raise self.error(unknown_key(unknown[0], allowed, name))
         return value
 
     def record(self, value: Any, name: str, keys: Sequence[str]) -> dict:

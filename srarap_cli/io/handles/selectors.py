@@ -21,7 +21,9 @@ def _indices(ctx, spec, V, base):
     idx = np.array([ctx.integer(i, "indices") for i in spec], dtype=np.int64)
     bad = idx[(idx < 0) | (idx >= len(V))]
     if bad.size:
-        raise ctx.error(f"indices: vertex {bad[0]} out of range (mesh has {len(V)} vertices)")
+        more = f" (and {bad.size - 1} more)" if bad.size > 1 else ""
+        raise ctx.error(f"indices: vertex {bad[0]}{more} out of range: the mesh has {len(V)} "
+                        f"vertices, ids 0..{len(V) - 1} (0-based)")
     return idx
 
 
