@@ -17,7 +17,7 @@ import pytest
 import yaml
 from click.testing import CliRunner
 from helpers import ROOT, tube_mesh
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 from srarap_cli.cli import main
@@ -289,8 +289,8 @@ def slow_batch(tmp_path_factory):
 
 
 @pytest.mark.slow
-@settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow,
-                                                                  HealthCheck.function_scoped_fixture])
+@settings(max_examples=3, deadline=None, phases=[Phase.generate],  # timed: no replaying
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(signum=st.sampled_from([signal.SIGINT, signal.SIGTERM]),
        delay=st.floats(0.3, 4.0), extra=st.sampled_from([[], ["--scheduler", "local"]]))
 def test_a_signal_stops_a_batch_within_seconds_with_a_true_summary(slow_batch, signum, delay,
@@ -320,7 +320,7 @@ def test_a_signal_stops_a_batch_within_seconds_with_a_true_summary(slow_batch, s
 
 # --- a signal at any moment of a run's start and end -------------------------------------
 
-@settings(max_examples=max(BUDGET // 4, 10), deadline=None,
+@settings(max_examples=max(BUDGET // 4, 10), deadline=None, phases=[Phase.generate],
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(signum=st.sampled_from([signal.SIGINT, signal.SIGTERM]), delay=st.floats(0.0, 1.5))
 def test_a_signal_at_any_moment_is_one_line_and_its_code(case, signum, delay):

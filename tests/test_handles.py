@@ -143,7 +143,7 @@ def test_invalid_solver_settings(tmp_path, solver, message):
 def test_malformed_yaml_reports_the_line(tmp_path):
     path = tmp_path / "h.yaml"
     path.write_text("groups:\n  a: {indices: [0\n")
-    with pytest.raises(InputError, match=r"h.yaml: not valid YAML \(line \d+\)"):
+    with pytest.raises(InputError, match=r"h.yaml: not valid YAML \(line \d+, column \d+\)"):
         load_handles(str(path), V)
 
 
@@ -163,3 +163,16 @@ def test_an_index_out_of_range_gives_the_valid_range(tmp_path):
     with pytest.raises(InputError, match=rf"vertex {n + 5} \(and 1 more\) out of range: the "
                                          rf"mesh has {n} vertices, ids 0..{n - 1} \(0-based\)"):
         load(tmp_path, {"groups": {"a": {"indices": [0, n + 5, -1], "fixed": True}}})
+
+
+def test_two_angles_are_named_as_the_mistake(tmp_path):
+    doc = {"groups": {"a": {"indices": [0], "rotate": {"axis": [0, 0, 1], "angle_deg": 30,
+                                                         "angle_rad": 0.5}}}}
+    with pytest.raises(InputError, match="rotate takes one angle, got angle_deg and angle_rad"):
+        load(tmp_path, doc)
+
+
+def test_a_yaml_syntax_error_gives_line_and_column(tmp_path):
+    (tmp_path / "h.yaml").write_text("groups:\n  a: {indices: [0, fixed: true}\n")
+    with pytest.raises(InputError, match=r"not valid YAML \(line 2, column \d+\)"):
+        load_handles(str(tmp_path / "h.yaml"), V)

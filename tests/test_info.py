@@ -133,3 +133,15 @@ def test_a_surface_cut_open_at_coincident_vertices_is_named():
     V2 = np.vstack([V, V[seam]])
     [line] = [w for w in mesh_warnings(V2, F2) if "sit exactly" in w]
     assert line.startswith(f"{seam.size} vertices sit exactly on another vertex ({seam.size} positions)")
+
+
+def test_info_gives_euler_characteristic_genus_and_unreferenced_vertices():
+    from helpers import torus
+
+    from srarap_cli.io.mesh import Mesh
+    from srarap_cli.tasks.info import mesh_info
+    V, F = torus()
+    closed = mesh_info(Mesh.from_arrays(V, F))
+    assert (closed["euler"], closed["genus"], closed["boundary_loops"]) == (0, 1, 0)
+    lonely = mesh_info(Mesh.from_arrays(np.vstack([V, [[9.0, 9, 9]]]), F))
+    assert lonely["genus"] == 1 and "1 unreferenced vertices" in lonely["problems"][-1]

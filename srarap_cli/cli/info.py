@@ -43,6 +43,8 @@ def _text(d):
         lines.append(f"  {axis}: {d['bbox_min'][k]:.6g} .. {d['bbox_max'][k]:.6g} "
                      f"(extent {d['extent'][k]:.6g})")
     lines.append(f"  diagonal {d['diagonal']:.6g}; up axis, a guess: {d['up_guess']}")
+    genus = "" if d["genus"] is None else f", genus {d['genus']}"
+    lines.append(f"  Euler characteristic {d['euler']}{genus}")
     lines += [f"  problem: {p}" for p in d["problems"]] or ["  no problems found"]
     if "groups" in d:
         lines.append(f"{d['handles']}: {len(d['groups'])} groups, {d['constrained']} "

@@ -56,7 +56,7 @@ def load_document(path: str, kind: str) -> Any:
     except (ValueError, yaml.YAMLError) as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         mark = getattr(exc, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark is not None else ""
+        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark is not None else ""
         raise InputError(f"{path}: not valid {kind.upper()}{where}: {first[:200]}") from None
 
 

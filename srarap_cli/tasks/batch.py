@@ -271,7 +271,7 @@ def _run_in_processes(jobs, run, workers):
     pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
     futures = []
     try:
-        futures = [pool.submit(_in_worker, run, job) for job in jobs]
+        futures = [pool.submit(run, job) for job in jobs]
         rows = [f.result() for f in futures]
     except (KeyboardInterrupt, Terminated) as exc:
         _stop(pool)
@@ -285,21 +285,12 @@ def _run_in_processes(jobs, run, workers):
 
 def _worker_signals():
     """A worker leaves SIGINT to the batch (a terminal's Ctrl-C reaches the whole group: the
-    batch stops the workers and reports); SIGTERM, from the batch, ends it once its
-    cleanup (temporary files) has run."""
+    batch stops the workers and reports) and leaves at once on SIGTERM, from the batch: an
+    exception raised there could land in any destructor and print a traceback. Its commits
+    hold signals back while they rename, and the temporary files it staged are swept by
+    the next write into their folder."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, _terminated)
-
-
-def _terminated(_signum, _frame):
-    raise Terminated()
-
-
-def _in_worker(run, job):
-    try:
-        return run(job)
-    except Terminated:  # the batch stops: leave without the pool's report of it
-        os._exit(143)
+    signal.signal(signal.SIGTERM, lambda signum, frame: os._exit(143))
 
 
 def _stop(pool):

@@ -21,16 +21,29 @@ def mesh_info(mesh: Mesh) -> dict:
     -------
     dict with ``vertices``, ``faces`` (polygons), ``triangles``, ``components`` (connected
     parts of the faces), ``boundary_loops``, ``bbox_min`` / ``bbox_max`` / ``extent`` (per
-    axis), ``diagonal``, ``up_guess`` and ``problems`` (list of str)
+    axis), ``diagonal``, ``up_guess``, ``euler`` (V - E + F of the triangles' vertices),
+    ``genus`` (of a surface with ``components`` parts and ``boundary_loops`` holes: the
+    number of handles, e.g. a torus's 1; None where that is not a whole number, a mesh that
+    is not a manifold) and ``problems`` (list of str, every mesh warning deform gives)
     """
     V = mesh.vertices
     F = mesh.triangles()[0]
     lo, hi = V.min(axis=0), V.max(axis=0)
+    components, loops = _components(F, len(V)), _boundary_loops(F)
+    used = np.unique(F).size
+    euler = used - len(edge_counts(F)[0]) + len(F)
+    twice_genus = 2 * components - loops - euler
+    problems = mesh_warnings(V, F)
+    if used < len(V):  # deform keeps them at rest and says so: say it before
+        problems.append(f"{len(V) - used} unreferenced vertices (in no face): a solve keeps "
+                        "them at rest")
     return {"vertices": len(V), "faces": int(mesh.face_sizes.size), "triangles": len(F),
-            "components": _components(F, len(V)), "boundary_loops": _boundary_loops(F),
+            "components": components, "boundary_loops": loops,
             "bbox_min": lo.tolist(), "bbox_max": hi.tolist(), "extent": (hi - lo).tolist(),
             "diagonal": float(np.linalg.norm(hi - lo)), "up_guess": _up_guess(V, F),
-            "problems": mesh_warnings(V, F)}
+            "euler": int(euler),
+            "genus": twice_genus // 2 if twice_genus >= 0 and twice_genus % 2 == 0 else None,
+            "problems": problems}
 
 
 def handles_info(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> dict:

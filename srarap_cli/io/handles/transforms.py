@@ -38,6 +38,9 @@ def rotation_matrix(ctx: Context, spec: dict) -> np.ndarray:
         if np.linalg.norm(q) < 1e-12:
             raise ctx.error(f"{key} must not be zero")
         return to_matrix(q / np.linalg.norm(q))
+    if len(angles) > 1:
+        raise ctx.error(f"rotate takes one angle, got {' and '.join(angles)}: keep angle_deg "
+                        "(degrees) or angle_rad (radians)")
     if "axis" not in spec or len(angles) != 1:
         raise ctx.error("rotate needs 'axis' and one of angle_deg, angle_rad or angle (degrees)")
     axis = _scaled(ctx.vector(spec["axis"], "axis", 3))
