@@ -96,11 +96,6 @@ def register_format(fmt: MeshFormat) -> MeshFormat:
     return fmt
 
 
-def format_names() -> list[str]:
-    """The registered format names, in registration order."""
-    return list(FORMATS)
-
-
 def extensions() -> list[str]:
     """Every registered extension (``.obj``, ...)."""
     return [ext for fmt in FORMATS.values() for ext in fmt.extensions]
