@@ -1,85 +1,155 @@
-"""End-to-end multiresolution deform of a large mesh: stage times and peak memory.
+"""Large meshes end to end: the stage table (seconds and peak memory per stage) of default
+``srarap deform`` on the 0.5M bar, the 1.2M cylinder and the 2M bar, optionally for a base
+revision too, in one run.
 
-Generates out/spot-738k.obj (sample cow Loop-subdivided 3 times, 737,986 vertices) when it
-is missing, then runs `srarap deform` on it with configs/spot-nod.yaml (hooves fixed, head
-turned 30 degrees) twice: with an empty cache folder, then with the cache filled. Each run is
-a separate process; its wall time includes interpreter start, loading and writing.
-``--mesh``/``--handles`` run another case (``--cold-only``: without the cached run), e.g. the
-stage table of the performance page:
+Each run is a separate process (``srarap deform -v``, wall time of the whole process: reading,
+setup, solve, writing); the stages come from its ``-v`` lines, the peak per stage from the
+process's high-water mark reset at each stage (Linux). The simplification and the
+full-resolution setup run side by side on two cores, so the stages add up to more than the
+wall time. Missing meshes are generated into ``out/``:
 
-    python benchmarks/make_big_bar.py out/bar-500k.obj --rings 1560 --segments 320
-    python benchmarks/make_big_spot.py out/cylinder-1m.obj --levels 4 --mesh ../shared/meshes/cylinder.off
-    python benchmarks/make_big_bar.py out/bar-2m.obj --rings 3120 --segments 640
-    python benchmarks/multires_large.py --cold-only --mesh out/bar-500k.obj \
-        --handles benchmarks/cases/bar-100k-twist.yaml
+    out/bar-500k.obj       benchmarks/make_big_bar.py --rings 1560 --segments 320
+    out/cylinder-1m.obj    benchmarks/make_big_spot.py --levels 4 --mesh ../shared/meshes/cylinder.off
+    out/bar-2m.obj         benchmarks/make_big_bar.py --rings 3120 --segments 640
 
-Run: python benchmarks/multires_large.py [--multires auto] [--runs 1] [--mesh M --handles H]
+``--base REV`` checks REV out into a git worktree (``out/base-REV``) and runs it with the
+same interpreter (``PYTHONPATH`` at the worktree), alternating base and HEAD per case, so
+both see the same machine. ``--cases`` picks some (``bar500k,cylinder1m,bar2m``), ``--mesh
+M --handles H`` runs another one; ``--runs`` repeats and prints medians.
+
+Run: python benchmarks/multires_large.py [--cases bar500k,cylinder1m] [--base REV] [--runs 1]
 """
 import argparse
 import json
 import os
-import shutil
+import re
+import statistics
 import subprocess
 import sys
+import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 OUT = os.path.join(ROOT, "out")
-MESH = os.path.join(OUT, "spot-738k.obj")
-HANDLES = os.path.join(ROOT, "configs", "spot-nod.yaml")
+SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")
+TWIST = os.path.join(HERE, "cases", "bar-100k-twist.yaml")
+CASES = {
+    "bar500k": ("bar-500k.obj", TWIST,
+                ["make_big_bar.py", "--rings", "1560", "--segments", "320"]),
+    "cylinder1m": ("cylinder-1m.obj", os.path.join(HERE, "cases", "cylinder-subdivided.yaml"),
+                   ["make_big_spot.py", "--levels", "4", "--mesh",
+                    os.path.join(SHARED, "cylinder.off")]),
+    "bar2m": ("bar-2m.obj", TWIST, ["make_big_bar.py", "--rings", "3120", "--segments", "640"]),
+}
+STAGES = ["simplify", "fine setup", "coarse setup", "coarse solve", "full-resolution start",
+          "full-resolution iterations"]
+# the setup stages share one memory window (they run side by side)
+SETUP_WINDOW = {"simplify": "setup", "fine setup": "setup", "coarse setup": "setup"}
 
-CHILD = """
-import resource, sys
-from srarap_cli.cli import main
-try:
-    main(sys.argv[1:], standalone_mode=False)
-finally:
-    print("peak_rss_mb", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-          file=sys.stderr)
+
+def _mesh(name):
+    file, handles, make = CASES[name]
+    path = os.path.join(OUT, file)
+    if not os.path.exists(path):
+        subprocess.run([sys.executable, os.path.join(HERE, make[0]), path, *make[1:]],
+                       check=True)
+    return path, handles
+
+
+# the package from the folder given, even where an editable install's finder would answer
+CHILD = """import runpy, sys
+sys.meta_path[:] = [f for f in sys.meta_path if "__editable__" not in getattr(f, "__module__", "")]
+sys.path.insert(0, sys.argv.pop(1))
+runpy.run_module("srarap_cli", run_name="__main__", alter_sys=True)
 """
 
 
-def run_once(args, cache):
-    stem = os.path.join(OUT, os.path.splitext(os.path.basename(args.mesh))[0] + "-deformed")
-    cmd = [sys.executable, "-c", CHILD, "deform", "-v", args.mesh, args.handles, "-o",
-           stem + ".obj", "--log", stem + ".csv", "--multires", str(args.multires),
-           "--cache", cache]
-    start = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    wall = time.perf_counter() - start
-    lines = proc.stderr.strip().splitlines()
-    peak = next(float(x.split()[1]) for x in lines if x.startswith("peak_rss_mb"))
-    stages = next((x for x in lines if x.startswith("srarap: multires:")), "")
-    summary = next((x for x in lines if x.startswith("srarap deform:")), proc.stderr)
-    return {"exit": proc.returncode, "wall_s": wall, "peak_rss_mb": peak, "stages": stages,
+def run_once(mesh, handles, code_root):
+    """One ``srarap deform -v`` of ``mesh`` with the package at ``code_root``."""
+    with tempfile.TemporaryDirectory() as tmp:
+        cmd = [sys.executable, "-c", CHILD, code_root, "deform", "-v", mesh, handles,
+               "-o", os.path.join(tmp, "out.obj")]
+        with open(os.path.join(tmp, "stderr"), "w+") as err:
+            start = time.perf_counter()
+            proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
+            _, status, usage = os.wait4(proc.pid, 0)  # this child's own peak, not the max of all
+            wall = time.perf_counter() - start
+            err.seek(0)
+            text = err.read()
+    peak = usage.ru_maxrss / 1024
+    stages = {k: float(v) for k, v in re.findall(r"([a-z -]+?) ([0-9.]+) s(?=[,\n]|$)",
+                                                 _line(text, "srarap: multires: ") or "")}
+    memory = {k.strip(): float(v) for k, v in re.findall(
+        r"([a-z -]+?) ([0-9.]+) GB", _line(text, "peak memory per stage:") or "")}
+    whole = {k.strip(): float(v) for k, v in re.findall(
+        r"([a-z -]+?) ([0-9.]+) GB", _line(text, "srarap: peak memory:") or "")}
+    summary = _line(text, "srarap deform:") or text.strip().splitlines()[-1:]
+    iterations = re.search(r"(\d+) full-resolution iterations \(\+ (\d+) coarse\)", summary)
+    return {"exit": os.waitstatus_to_exitcode(status), "wall_s": wall, "max_rss_mb": peak,
+            "stages_s": {k.strip(): v for k, v in stages.items()}, "stage_peak_gb": memory,
+            "peak_gb": whole, "iterations": iterations.groups() if iterations else None,
             "summary": summary}
+
+
+def _line(text, marker):
+    return next((x for x in text.splitlines() if marker in x), None)
+
+
+def _worktree(rev):
+    path = os.path.join(OUT, f"base-{rev}")
+    if not os.path.isdir(path):
+        subprocess.run(["git", "-C", ROOT, "worktree", "add", "--detach", path, rev],
+                       check=True, capture_output=True)
+    return path
+
+
+def _row(label, runs):
+    def med(get):
+        values = [v for v in (get(r) for r in runs) if v is not None]
+        return statistics.median(values) if values else None
+
+    def fmt(v, unit):
+        return "-" if v is None else f"{v:.1f}{unit}" if unit == " s" else f"{v:.2f}{unit}"
+
+    first = runs[0]
+    its = "/".join(first["iterations"]) if first["iterations"] else "-"
+    peak = med(lambda r: r["max_rss_mb"] * 1.048576e-3)
+    cells = [label, str(first["exit"]), fmt(med(lambda r: r["wall_s"]), " s"),
+             fmt(peak, " GB"), its]
+    for stage in STAGES:
+        window = SETUP_WINDOW.get(stage, stage)
+        s = med(lambda r, stage=stage: r["stages_s"].get(stage))
+        m = med(lambda r, window=window: r["stage_peak_gb"].get(window))
+        cells.append(f"{fmt(s, ' s')} / {fmt(m, ' GB')}")
+    return "| " + " | ".join(cells) + " |"
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--multires", default="auto")
-    ap.add_argument("--mesh", default=MESH)
-    ap.add_argument("--handles", default=HANDLES)
-    ap.add_argument("--cold-only", action="store_true", help="no second run from the cache")
+    ap.add_argument("--cases", default="bar500k,cylinder1m,bar2m")
+    ap.add_argument("--mesh")
+    ap.add_argument("--handles")
+    ap.add_argument("--base", help="a git revision to measure beside the working tree")
     ap.add_argument("--runs", type=int, default=1)
     ap.add_argument("--json")
     args = ap.parse_args()
-    if args.mesh == MESH and not os.path.exists(MESH):
-        subprocess.run([sys.executable, os.path.join(HERE, "make_big_spot.py"), MESH,
-                        "--levels", "3"], check=True)
-    results = []
-    for _ in range(args.runs):
-        cache = os.path.join(OUT, "multires-cache")
-        shutil.rmtree(cache, ignore_errors=True)
-        results.append({"cold": run_once(args, cache)})
-        if not args.cold_only:
-            results[-1]["warm"] = run_once(args, cache)
-    for r in results:
-        for kind in r:
-            x = r[kind]
-            print(f"{kind} cache: exit {x['exit']}, wall {x['wall_s']:.1f} s, "
-                  f"peak {x['peak_rss_mb']:.0f} MB\n  {x['stages']}\n  {x['summary']}")
+    cases = ([(os.path.basename(args.mesh), (args.mesh, args.handles))] if args.mesh
+             else [(name, _mesh(name)) for name in args.cases.split(",")])
+    codes = [("HEAD", ROOT)] + ([(args.base, _worktree(args.base))] if args.base else [])
+    results = {}
+    for name, (mesh, handles) in cases:
+        for _ in range(args.runs):
+            for label, root in codes[::-1]:  # base first, then the working tree
+                run = run_once(mesh, handles, root)
+                results.setdefault(f"{name} {label}", []).append(run)
+                print(f"{name} {label}: exit {run['exit']}, {run['wall_s']:.1f} s, "
+                      f"{run['summary']}", file=sys.stderr, flush=True)
+    print("| case | exit | wall | peak | iterations (fine/coarse) | "
+          + " | ".join(f"{s} (s / peak)" for s in STAGES) + " |")
+    print("|---" * (5 + len(STAGES)) + "|")
+    for label, runs in results.items():
+        print(_row(label, runs))
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(results, fh, indent=1)

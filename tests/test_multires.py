@@ -9,6 +9,7 @@ from helpers import ROOT, SHARED, needs_shared, random_rotation, torus, tube
 from srarap_cli.cli import main
 from srarap_cli.io.handles import load_handles
 from srarap_cli.io.mesh import read_mesh
+from srarap_cli.runtime import memory
 from srarap_cli.solver.group_rotations import group_rotors
 from srarap_cli.solver.multires import (
     MultiresDeformer,
@@ -197,6 +198,9 @@ def test_cli_multires_runs_caches_and_gives_identical_files(tmp_path):
     assert one.exit_code in (0, 3), one.output
     assert "srarap: multires: " in one.output and "approximate (multires transfer" in one.output
     assert "full-resolution energy" in one.output and "at the start" in one.output
+    if memory.start() is not None:  # -v gives each stage's peak resident memory
+        assert "peak memory per stage: setup " in one.output and "transfer " in one.output
+        assert "srarap: peak memory: read " in one.output and " write " in one.output
     two = runner.invoke(main, args + ["-o", str(tmp_path / "b.obj")])
     assert "coarse mesh from cache" in two.output
     assert (tmp_path / "a.obj").read_bytes() == (tmp_path / "b.obj").read_bytes()

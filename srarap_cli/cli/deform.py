@@ -10,7 +10,7 @@ from ..io.handles import load_handles
 from ..io.mesh import FORMATS
 from ..io.mesh.formats import MeshFormat, by_extension, extensions
 from ..io.solve_log import LOG_FORMATS, format_log
-from ..runtime import descriptors, exit_codes
+from ..runtime import descriptors, exit_codes, memory
 from ..runtime.commit import commit_files
 from ..runtime.errors import OutputError
 from ..runtime.limits import check_solve
@@ -87,7 +87,9 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
         if os.path.abspath(log) == os.path.abspath(out):
             raise click.UsageError("--log and --output name the same file")
     refuse_overwrite([out, log, preview], mesh=mesh, handles=handles)
+    peak = memory.start()
     source, source_format = read_any_mesh(mesh, input_format)
+    peaks = {"read": memory.stop(peak)}
     if fmt is None:
         fmt = source_format
         _check_format_options(fmt, ascii, write_distortion)
@@ -96,11 +98,13 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
     constraints = load_handles(handles, source.vertices)
     opts = resolve(constraints.solver, overrides)
     progress = SolveProgress(enabled=verbosity != 0 and sys.stderr.isatty())
+    peak = memory.start()
     try:
         deformed, result, notes = deform_mesh(source, constraints, opts, callback=progress,
                                               cache=cache, name=name)
     finally:
         progress.close()
+    peaks["solve"], peak = memory.stop(peak), memory.start()
     if write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
@@ -116,8 +120,12 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
     if keep and out == "-":  # first: the files are committed only once it was written
         write_stdout(mesh_bytes)
     commit_files(files)
+    peaks["write"] = memory.stop(peak)
     shown = "<stdout>" if out == "-" else out
-    report(verbosity, warnings=notes + lost, details=result.report_lines(),
+    measured = memory.gigabytes(peaks)
+    report(verbosity, warnings=notes + lost,
+           details=result.report_lines() + ([f"srarap: peak memory: {measured}"]
+                                             if measured else []),
            summary=_summary(result, opts, shown if keep else None))
     if not done:
         raise SystemExit(exit_codes.NOT_CONVERGED)

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ...runtime import memory
 from ...runtime.errors import NumericalError
 from ...runtime.threads import background, single_threaded
 from .. import api_checks
@@ -60,6 +61,8 @@ class MultiresResult(DeformResult):
     start_energy : dict, transfer mode: the full-resolution energies of the rest shape with
         the constrained vertices at their targets (what the approximation is judged against)
     wall : float, wall seconds of the solve (setup excluded)
+    memory : dict, peak resident bytes per stage (``setup``, then the solve's stages; None
+        where the platform cannot tell, see :mod:`srarap_cli.runtime.memory`)
     """
 
     coarse_log: bool = True
@@ -70,6 +73,7 @@ class MultiresResult(DeformResult):
     coarse_stop_reason: StopReason | None = None
     start_energy: dict = field(default_factory=dict)
     wall: float = 0.0
+    memory: dict = field(default_factory=dict)
 
     def energies(self) -> dict[str, float]:
         return dict(self.full_energy)
@@ -99,7 +103,9 @@ class MultiresResult(DeformResult):
         info = self.coarse
         cached = " (coarse mesh from cache)" if info["cache_hit"] else ""
         times = ", ".join(f"{STAGE_NAMES.get(k, k)} {v:.2f} s" for k, v in self.stages.items())
-        return [f"srarap: multires: {info['vertices']} of {info['of']} vertices{cached}; {times}"]
+        lines = [f"srarap: multires: {info['vertices']} of {info['of']} vertices{cached}; {times}"]
+        peaks = memory.gigabytes({STAGE_NAMES.get(k, k): v for k, v in self.memory.items()})
+        return lines + ([f"srarap: multires: peak memory per stage: {peaks}"] if peaks else [])
 
 
 class _Delayed:
@@ -181,7 +187,7 @@ class MultiresDeformer:
         self.settings = with_keywords(settings, options, ("setup", "solve", "build"),
                                       "MultiresDeformer")
         self.mode = mode = self.settings.multires_mode
-        start = time.perf_counter()
+        start, peak = time.perf_counter(), memory.start()
         self.V, self.F = api_checks.mesh_arrays(V, F)
         self.constrained = api_checks.vertex_ids(constrained, len(self.V))
         size = coarse_size(self.settings.multires, len(self.V)) if size is None else size
@@ -201,6 +207,7 @@ class MultiresDeformer:
         self.area = self.fine.area
         self.direct = self._no_gain()
         if self.direct is not None:
+            memory.stop(peak)
             return
         self._build_coarse(cache)
         mark = time.perf_counter()
@@ -211,6 +218,7 @@ class MultiresDeformer:
         self.stages["factor"] = fine_setup + time.perf_counter() - mark
         self.warnings = (self.fine.warnings + notes
                          + [f"multires: {w}" for w in self.coarse.warnings])
+        self.memory = {"setup": memory.stop(peak)}
 
     def _no_gain(self):
         """The full-resolution Deformer when the simplification kept more than half the
@@ -289,19 +297,23 @@ class MultiresDeformer:
         cv = self.coarse.vertices
         warm = None if initial is None else (np.asarray(initial[0])[cv],
                                               np.asarray(initial[1])[cv])
+        peak = memory.start()
         coarse = self.coarse_deformer.solve(targets[self._coarse_slots], initial=warm,
                                             callback=callback, settings=s, start=start)
         stages = dict(self.stages, coarse_solve=time.perf_counter() - begin)
+        peaks = dict(self.memory, coarse_solve=memory.stop(peak))
         log = [dict(row, step="coarse-" + row["step"]) for row in coarse.log]
         if self.mode == "transfer":
-            return self._transfer(targets, coarse, log, stages, begin)
-        mark = time.perf_counter()
+            return self._transfer(targets, coarse, log, stages, begin, peaks)
+        mark, peak = time.perf_counter(), memory.start()
         first = self._fine_start(targets, s.tol, coarse, start or s.start)
         stages["fine_start"] = time.perf_counter() - mark
-        mark = time.perf_counter()
+        peaks["fine_start"] = memory.stop(peak)
+        mark, peak = time.perf_counter(), memory.start()
         fine = self.fine.solve(targets, initial=first, start="extrapolated", callback=callback,
                                driver=self._driver(targets, s.tol, s.accel), settings=s)
         stages["fine_iterations"] = time.perf_counter() - mark
+        peaks["fine_iterations"] = memory.stop(peak)
         offset, elapsed = len(log), mark - begin
         log += [dict(row, iteration=row["iteration"] + offset, seconds=row["seconds"] + elapsed)
                 for row in fine.log]
@@ -310,7 +322,7 @@ class MultiresDeformer:
                               full_energy=fine.energies(), stages=stages, coarse=self.info,
                               coarse_iterations=_all_iterations(coarse),
                               coarse_stop_reason=coarse.stop_reason,
-                              wall=time.perf_counter() - begin)
+                              wall=time.perf_counter() - begin, memory=peaks)
 
     def _warm(self, targets, initial, callback, settings, start, begin):
         """A warm start (an animation's next frame, a nearby pose) goes straight to the
@@ -373,9 +385,9 @@ class MultiresDeformer:
         best = min(candidates, key=lambda state: state.total)
         return best.positions, best.rotors
 
-    def _transfer(self, targets, coarse, log, stages, begin):
+    def _transfer(self, targets, coarse, log, stages, begin, peaks):
         """The paper's result: coarse rotors spread harmonically, one Poisson solve."""
-        mark = time.perf_counter()
+        mark, peak = time.perf_counter(), memory.start()
         R = spread_rotors(self.solver, self._known_rotors(targets, coarse.rotors))
         stages["transfer"] = time.perf_counter() - mark
         mark = time.perf_counter()
@@ -392,7 +404,8 @@ class MultiresDeformer:
                               stages=stages, coarse=self.info,
                               coarse_iterations=_all_iterations(coarse),
                               coarse_stop_reason=coarse.stop_reason, start_energy=start,
-                              wall=time.perf_counter() - begin)
+                              wall=time.perf_counter() - begin,
+                              memory=dict(peaks, transfer=memory.stop(peak)))
 
     def _known_rotors(self, targets, coarse_rotors):
         out = np.tile(IDENTITY, (self._known.size, 1))
