@@ -19,7 +19,7 @@ from srarap_cli.tasks.animation import _carried
 
 TWIST = ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
          "  top:\n    box: {min: [-2, -2, 9.99], max: [2, 2, 10.01]}\n    keyframes:\n"
-         "      - {frame: 0}\n      - {frame: 9, rotate: {axis: [0, 0, 1], angle: 27}}\n")
+         "      - {frame: 0}\n      - {frame: 9, rotate: {axis: [0, 0, 1], angle_deg: 27}}\n")
 
 
 @pytest.fixture

@@ -1,5 +1,7 @@
 """Peak resident memory per stage (runtime.memory): nested stages, each stage's own peak."""
-import numpy as np
+import subprocess
+import sys
+
 import pytest
 
 from srarap_cli.runtime import memory
@@ -9,21 +11,31 @@ pytestmark = pytest.mark.skipif(memory.start() is None, reason="no /proc high-wa
 MB = 1 << 20
 
 
-def _touch(megabytes):
-    """Resident memory of that size for a moment (written, so the pages are real)."""
-    block = np.ones(megabytes * MB // 8)
+# in a fresh process: one whose allocator keeps freed memory resident (the solver's setup
+# asks glibc to) would reuse it, and a stage's peak would not rise
+STAGES = """
+import numpy as np
+from srarap_cli.runtime import memory
+
+def touch(megabytes):
+    block = np.ones(megabytes * (1 << 20) // 8)
     del block
+
+outer = memory.start()
+first = memory.start()
+touch(200)
+big = memory.stop(first)
+second = memory.start()
+touch(20)
+small = memory.stop(second)
+print(big, small, memory.stop(outer))
+"""
 
 
 def test_a_stage_sees_the_memory_it_touched_and_a_later_stage_does_not():
-    outer = memory.start()
-    first = memory.start()
-    _touch(200)
-    big = memory.stop(first)
-    second = memory.start()
-    _touch(20)
-    small = memory.stop(second)
-    whole = memory.stop(outer)
+    out = subprocess.run([sys.executable, "-c", STAGES], capture_output=True, text=True,
+                         check=True).stdout
+    big, small, whole = map(int, out.split())
     assert big - small > 150 * MB  # the reset: the second stage did not inherit the first's
     assert whole >= big  # the enclosing stage keeps the peak of everything inside it
 

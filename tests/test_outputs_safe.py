@@ -16,11 +16,11 @@ from srarap_cli.runtime.errors import OutputError
 
 HANDLES = ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
            "  tip: {box: {min: [-2, -2, 5.99], max: [2, 2, 6.01]}, rotate: "
-           "{axis: [0, 0, 1], angle: 30}}\n")
+           "{axis: [0, 0, 1], angle_deg: 30}}\n")
 KEYED = ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
          "  tip:\n    box: {min: [-2, -2, 5.99], max: [2, 2, 6.01]}\n"
-         "    keyframes:\n      - {frame: 0, rotate: {axis: [0, 0, 1], angle: 0}}\n"
-         "      - {frame: 2, rotate: {axis: [0, 0, 1], angle: 20}}\n")
+         "    keyframes:\n      - {frame: 0, rotate: {axis: [0, 0, 1], angle_deg: 0}}\n"
+         "      - {frame: 2, rotate: {axis: [0, 0, 1], angle_deg: 20}}\n")
 
 
 @pytest.fixture

@@ -12,7 +12,7 @@ from srarap_cli.io.mesh import write_mesh
 
 HANDLES = ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
            "  tip: {box: {min: [-2, -2, 5.99], max: [2, 2, 6.01]}, rotate: "
-           "{axis: [0, 0, 1], angle: 90}}\n")
+           "{axis: [0, 0, 1], angle_deg: 90}}\n")
 
 
 @pytest.fixture

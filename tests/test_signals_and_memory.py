@@ -20,7 +20,7 @@ from srarap_cli.io.mesh import write_mesh
 
 HANDLES = ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
            "  tip: {box: {min: [-2, -2, 9.99], max: [2, 2, 10.01]}, rotate: "
-           "{axis: [0, 1, 0], angle: 40}}\n")
+           "{axis: [0, 1, 0], angle_deg: 40}}\n")
 
 
 @pytest.fixture

@@ -18,7 +18,7 @@ from ..solver.multires.size import AUTO_THRESHOLD
 from ..solver.settings import resolve
 from ..solver.stop import StopReason
 from ..tasks.distortion import vertex_distortion
-from ..tasks.pipeline import deform_mesh
+from ..tasks.pipeline import deform_mesh, refuse_warnings
 from ..tasks.preview import preview_png
 from .common import (
     MeshFormatType,
@@ -110,6 +110,7 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
             source.vertices, deformed.vertices, source.triangles()[0])
     done = result.complete
     mesh_bytes, lost = fmt.encode(deformed, ascii)
+    refuse_warnings(opts, lost)
     keep = done or keep_unconverged
     files = [(out, mesh_bytes)] if keep and out != "-" else []
     if preview is not None and keep:

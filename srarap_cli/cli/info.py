@@ -56,4 +56,5 @@ def _text(d):
         for o in d["overlaps"]:
             lines.append(f"  overlap: {o['vertices']} vertices in both "
                          f"{o['groups'][0]!r} and {o['groups'][1]!r}")
+        lines += [f"  warning: {w}" for w in d["warnings"]]
     return "\n".join(lines)

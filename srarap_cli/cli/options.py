@@ -22,6 +22,9 @@ def setting_option(setting: Setting, default: object = None) -> Callable[[F], F]
     the defaults fill in). ``default`` replaces the shown default where a command has its own."""
     shown = setting.default if default is None else default
     text = f"{setting.help} [default: {'none' if shown is None else shown}]"
+    if setting.kind == "flag":
+        return click.option(setting.flag, setting.name, is_flag=True, default=None,
+                            help=f"{setting.help} [default: off]")
     if setting.kind == "choice":
         kind, callback = click.Choice(setting.choices), None
     elif setting.kind == "size":
@@ -71,6 +74,7 @@ def markdown_table() -> str:
     """The solver settings as the README's Markdown table (a test keeps the two equal)."""
     rows = ["| option | default | meaning |", "|---|---|---|"]
     for s in SETTINGS:
-        default = "none" if s.default is None else f"`{s.default}`"
+        default = ("none" if s.default is None else "off" if s.kind == "flag"
+                   else f"`{s.default}`")
         rows.append(f"| `{s.flag}` | {default} | {s.help} |")
     return "\n".join(rows) + "\n"

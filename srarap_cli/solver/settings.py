@@ -8,7 +8,8 @@ code that uses it.
 
 ``stage`` says when the setting can change: ``setup`` is fixed when a solver is built (once per
 mesh and constraint set), ``solve`` may change with each ``solve`` call, ``build`` chooses the
-solver itself (direct or multiresolution).
+solver itself (direct or multiresolution); ``run`` settings are not the solver's but the
+run's around it (commands and the one-call API), so solver classes do not take them.
 """
 import math
 from collections.abc import Callable, Mapping
@@ -32,10 +33,10 @@ class Setting:
     Attributes
     ----------
     name : str, the Python keyword and handle-file key (the CLI flag uses dashes)
-    kind : {"float", "int", "choice", "size"}
+    kind : {"float", "int", "choice", "size", "flag"}
     default : the value when nobody gives one (None: no limit)
     help : str, one sentence for ``--help`` and the README
-    stage : {"setup", "solve", "build"}
+    stage : {"setup", "solve", "build", "run"}
     minimum : float or int, optional lower bound; ``strict`` excludes it
     choices : tuple of str, for ``choice``
     method : str, optional; the local step the setting belongs to (it is ignored by others)
@@ -62,6 +63,10 @@ class Setting:
         if self.kind == "choice":
             if value not in self.choices:
                 raise error(f"{self.name} must be one of {', '.join(self.choices)}")
+            return value
+        if self.kind == "flag":
+            if not isinstance(value, bool):
+                raise error(f"{self.name} must be true or false")
             return value
         if self.kind == "size":
             try:
@@ -129,6 +134,9 @@ SETTINGS = (
             "With multires: refine = the transferred result starts full-resolution iterations "
             "run to tol; transfer = stop after the transfer (the paper's approximation).",
             "build", choices=("refine", "transfer")),
+    Setting("strict", "flag", False,
+            "Treat every warning (an implausible motion, a mesh problem, data the output "
+            "format drops) as an error: exit 4 with the warning as the message.", "run"),
 )
 BY_NAME = {s.name: s for s in SETTINGS}
 DEFAULTS: dict[str, Any] = {s.name: s.default for s in SETTINGS}
@@ -168,6 +176,7 @@ class Settings:
     start: str
     multires: int | float | str
     multires_mode: str
+    strict: bool
 
     def __post_init__(self) -> None:
         for name in NAMES:
@@ -186,11 +195,11 @@ class Settings:
     def fixed_at_setup(self, other: "Settings") -> list[str]:
         """The setup and build settings in which ``other`` differs from this one: what a
         solver built with this one cannot change per solve."""
-        return [s.name for s in SETTINGS if s.stage != "solve"
+        return [s.name for s in SETTINGS if s.stage in ("setup", "build")
                 and getattr(self, s.name) != getattr(other, s.name)]
 
 
-STAGES = ("setup", "solve", "build")
+STAGES = ("setup", "solve", "build", "run")
 
 
 def resolve(*layers: "Mapping[str, Any] | Settings") -> Settings:

@@ -83,7 +83,8 @@ class Animator:
         self.constraints = constraints
         self.problem = problem(mesh, constraints, name)
         #: warnings: what the mesh checks and the solver found (e.g. mesh problems)
-        self.deformer, self.warnings = command_solver(mesh, self.problem, opts, cache)
+        self.deformer, self.warnings = command_solver(mesh, self.problem, opts, cache,
+                                                      constraints.warnings)
         self.last_result: DeformResult | None = None
 
     def run(self, frames: int, *, max_iter: int | None = None, stop_unconverged: bool = False,

@@ -10,7 +10,7 @@ from ..io.mesh.mesh import Mesh
 from ..solver.api_checks import mesh_like
 from ..solver.deformer import DeformResult
 from ..solver.oneshot import deform as deform_arrays
-from ..solver.settings import Settings, keywords, resolve
+from ..solver.settings import STAGES, Settings, keywords, resolve
 from .pipeline import deform_mesh
 
 
@@ -60,7 +60,7 @@ def deform(mesh: Any, handles: Any, *arrays: Any,
     if initial is not None:
         raise TypeError("deform(mesh, handles) starts cold; for a warm start use "
                         "deform(V, F, constrained, targets, initial=...) or a Deformer")
-    given = keywords(options, ("setup", "solve", "build"), "deform")
+    given = keywords(options, STAGES, "deform")
     arrays = mesh_like(mesh)  # checked whatever its type: a NaN is the mesh's, not a handle's
     source = mesh if isinstance(mesh, Mesh) else Mesh.from_arrays(*arrays)
     constraints = as_constraints(handles, source.vertices)

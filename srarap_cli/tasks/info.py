@@ -48,7 +48,9 @@ def mesh_info(mesh: Mesh) -> dict:
 
 def handles_info(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> dict:
     """Per group of ``constraints``: vertices selected, the action in words, overlaps; the
-    region's size and how many vertices are free. Runs the checks a solve would (a dry run).
+    region's size and how many vertices are free; ``warnings``, what deform would warn about
+    the file (an angle's unit, a motion beyond the mesh's size). Runs the checks a solve
+    would (a dry run).
     """
     p = problem(mesh, constraints, name)  # the same validation as deform
     slots = {g: np.searchsorted(constraints.ids, ids) for g, ids in constraints.groups.items()}
@@ -64,7 +66,8 @@ def handles_info(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> di
     region = None if constraints.region is None else int(np.unique(constraints.region).size)
     return {"groups": groups, "overlaps": _overlaps(constraints.groups, n),
             "constrained": int(constraints.ids.size), "region": region,
-            "free": int(len(p.V) - p.ids.size), "of": n}
+            "free": int(len(p.V) - p.ids.size), "of": n,
+            "warnings": list(constraints.warnings)}
 
 
 def describe_motion(rest: np.ndarray, targets: np.ndarray) -> str:

@@ -1,5 +1,5 @@
 """From a mesh and its constraints to the deformed mesh: the path every command shares."""
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -84,17 +84,28 @@ def _labels(constraints, full_ids):
     return np.unique(labels, return_inverse=True)[1].ravel()
 
 
-def command_solver(mesh: Mesh, p: Problem, opts: Settings,
-                   cache: str | None = None) -> tuple[Solver, list[str]]:
-    """The solver of ``p`` for a command (deform, animate) and the warnings of the mesh and
-    of the solver. The mesh checks run before the solver is built, so their temporaries
-    (edge tables of the whole mesh) do not add to the memory it holds (2M-vertex bar: peak
-    11.4 -> 10.6 GiB); once it is built, the process keeps freed memory for reuse."""
-    notes = mesh_warnings(mesh.vertices, mesh.triangles()[0])
+def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = None,
+                   handle_warnings: Sequence[str] = ()) -> tuple[Solver, list[str]]:
+    """The solver of ``p`` for a command (deform, animate) and the warnings of the handle
+    file (``handle_warnings``), the mesh and the solver; under ``opts.strict`` the first
+    warning is raised instead (before the solver is built, where it can be). The mesh checks
+    run before the solver is built, so their temporaries (edge tables of the whole mesh) do
+    not add to the memory it holds (2M-vertex bar: peak 11.4 -> 10.6 GiB); once it is
+    built, the process keeps freed memory for reuse."""
+    notes = list(handle_warnings) + mesh_warnings(mesh.vertices, mesh.triangles()[0])
+    refuse_warnings(opts, notes)
     deformer = make_deformer(p.V, p.F, p.ids, p.labels, settings=opts, area=p.area,
                              cache=cache)
     keep_freed_memory()  # after the setup, whose large arrays are allocated once
-    return deformer, notes + list(deformer.warnings)
+    notes += list(deformer.warnings)
+    refuse_warnings(opts, notes)
+    return deformer, notes
+
+
+def refuse_warnings(opts: Settings, warnings: Sequence[str]) -> None:
+    """Under ``strict``, the first of ``warnings`` as an :class:`InputError` (exit 4)."""
+    if opts.strict and warnings:
+        raise InputError(f"{warnings[0]} (strict: warnings are errors)")
 
 
 def scatter(mesh: Mesh, p: Problem, positions: np.ndarray, constraints: Constraints,
@@ -134,7 +145,7 @@ def deform_mesh(mesh: Mesh, constraints: Constraints, settings: Settings | None 
     settings = with_keywords(settings or resolve(constraints.solver), options, STAGES,
                              "deform_mesh")
     p = problem(mesh, constraints, name)
-    deformer, notes = command_solver(mesh, p, settings, cache)
+    deformer, notes = command_solver(mesh, p, settings, cache, constraints.warnings)
     sub_result = deformer.solve(p.targets, callback=callback)
     positions = scatter(mesh, p, sub_result.positions, constraints)
     rotors = np.tile(IDENTITY, (len(positions), 1))

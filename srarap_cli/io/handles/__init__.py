@@ -20,7 +20,7 @@ from .fields import Context
 from .formats import read_def, read_sel
 from .keys import parse_track
 from .selectors import SELECTOR_KEYS, select
-from .transforms import ACTION_KEYS, targets
+from .transforms import ACTION_KEYS, check_reach, targets
 
 TOP_KEYS = ("groups", "region", "solver")
 ANIMATION_KEYS = ("keyframes", "easing")
@@ -40,6 +40,8 @@ class Constraints:
     solver : dict, solver settings given in the file (see :mod:`srarap_cli.solver.settings`)
     tracks : list of (slots, rest, Track): keyframed groups, ``slots`` indexing ``ids``;
         ``targets`` holds their pose at frame 0
+    warnings : list of str, what the file says that is valid but looks like a mistake (an
+        angle's unit, a motion larger than the mesh), each naming file and group
     """
 
     ids: np.ndarray
@@ -48,6 +50,7 @@ class Constraints:
     region: np.ndarray | None = None
     solver: dict = field(default_factory=dict)
     tracks: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
 
     @property
     def last_key_frame(self) -> float:
@@ -132,6 +135,7 @@ def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = 
     if not isinstance(groups, dict) or not groups:
         raise ctx.error("'groups' must map at least one group name to its selection and action")
     names, ids, tgts, tracks = [], [], [], {}
+    diagonal = float(np.linalg.norm(np.ptp(V, axis=0))) if len(V) else 0.0
     for name, spec in groups.items():
         gctx = ctx.at(f"group {name!r}")
         spec = gctx.mapping(spec, "the group", SELECTOR_KEYS + ACTION_KEYS + ANIMATION_KEYS)
@@ -139,12 +143,16 @@ def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = 
         names.append(str(name))
         ids.append(sel)
         if "keyframes" in spec:
-            tracks[str(name)] = parse_track(gctx, spec, V[sel], fps)
-            tgts.append(tracks[str(name)].apply(V[sel], 0.0))
+            track = tracks[str(name)] = parse_track(gctx, spec, V[sel], fps)
+            tgts.append(track.apply(V[sel], 0.0))
+            for frame in track.frames:
+                check_reach(gctx, V[sel], track.apply(V[sel], float(frame)), diagonal,
+                            f"its keyframe at frame {float(frame):g}")
         else:
             if "easing" in spec:
                 raise gctx.error("easing only applies together with keyframes")
             tgts.append(targets(gctx, spec, V[sel], base))
+            check_reach(gctx, V[sel], tgts[-1], diagonal)
     region = None
     if "region" in doc:
         rctx = ctx.at("region")
@@ -153,7 +161,8 @@ def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = 
     return Constraints(ids=merged_ids, targets=merged, groups=dict(zip(names, ids)),
                        region=region, solver=parse_mapping(doc.get("solver", {}), "solver",
                                             ctx.at("solver").error),
-                       tracks=_tracks(ctx, tracks, dict(zip(names, ids)), merged_ids, V))
+                       tracks=_tracks(ctx, tracks, dict(zip(names, ids)), merged_ids, V),
+                       warnings=ctx.warnings)
 
 
 def _tracks(ctx, tracks, groups, merged_ids, V):

@@ -11,18 +11,31 @@ MAX_INT = 2 ** 53
 
 
 class Context:
-    """Where a value sits in the handle file, for one-line error messages."""
+    """Where a value sits in the handle file, for one-line error messages and warnings.
 
-    def __init__(self, path: str, where: str = "") -> None:
+    Attributes
+    ----------
+    warnings : list of str, shared by every Context made with :meth:`at`: what was accepted
+        but looks like a mistake (see :meth:`warn`)
+    """
+
+    def __init__(self, path: str, where: str = "", warnings: list[str] | None = None) -> None:
         self.path = path
         self.where = where
+        self.warnings = [] if warnings is None else warnings
 
     def at(self, where: str) -> "Context":
-        return Context(self.path, where)
+        return Context(self.path, where, self.warnings)
+
+    def _prefixed(self, message):
+        return (f"{self.path}: {self.where}: " if self.where else f"{self.path}: ") + message
 
     def error(self, message: str) -> InputError:
-        prefix = f"{self.path}: {self.where}: " if self.where else f"{self.path}: "
-        return InputError(prefix + message)
+        return InputError(self._prefixed(message))
+
+    def warn(self, message: str) -> None:
+        """Record a warning naming the file and where in it (``--strict`` makes it an error)."""
+        self.warnings.append(self._prefixed(message))
 
     def mapping(self, value: Any, name: str, allowed: Iterable[str]) -> dict:
         if not isinstance(value, dict):

@@ -73,6 +73,7 @@ def _keyframe():
 
 def _setting(s):
     kind = {"float": {"type": "number"}, "int": {"type": "integer"},
+            "flag": {"type": "boolean"},
             "choice": {"enum": list(s.choices)},
             "size": {"oneOf": [{"type": "integer", "minimum": 4},
                                {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},

@@ -47,7 +47,22 @@ def rotation_matrix(ctx: Context, spec: dict) -> np.ndarray:
     if np.linalg.norm(axis) < 1e-12:
         raise ctx.error("axis must not be zero")
     key = angles[0]
-    return to_matrix(from_axis_angle(axis, ctx.number(spec[key], key) * ANGLE_KEYS[key]))
+    value = ctx.number(spec[key], key)
+    _check_angle(ctx, key, value)
+    return to_matrix(from_axis_angle(axis, value * ANGLE_KEYS[key]))
+
+
+def _check_angle(ctx, key, value):
+    """Warn where the unit looks mistaken: radians beyond a full turn (degrees meant), or
+    ``angle``, whose unit the reader has to know."""
+    if key == "angle_rad" and abs(value) > 2 * np.pi:
+        ctx.warn(f"angle_rad {value:g} is {np.degrees(value):g} degrees, more than a full "
+                 "turn: if degrees were meant, write angle_deg")
+    elif key == "angle":
+        hint = (" (a value this small looks like radians: write angle_rad if so)"
+                if 0 < abs(value) <= 2 * np.pi else "")
+        ctx.warn(f"angle {value:g} is read as degrees{hint}; write angle_deg or angle_rad "
+                 "to say which")
 
 
 def _scaled(v):
@@ -81,6 +96,19 @@ def targets(ctx: Context, spec: dict, rest: np.ndarray, base: str) -> np.ndarray
         raise ctx.error(f"the action{where} sends vertices beyond {MAX_COORDINATE:g} or to "
                         "infinite/NaN positions (entries too large)")
     return out
+
+
+def check_reach(ctx: Context, rest: np.ndarray, moved: np.ndarray, diagonal: float,
+                what: str = "its targets") -> None:
+    """Warn when a group's targets ``moved`` (k, 3) lie farther from its rest positions
+    ``rest`` than the mesh's bounding-box ``diagonal``: a translation in other units, or a
+    target meant for another mesh, deforms "successfully" into a stretched shape."""
+    if not len(rest) or not diagonal > 0:
+        return
+    reach = float(np.sqrt(np.max(np.einsum("ij,ij->i", moved - rest, moved - rest))))
+    if reach > diagonal:
+        ctx.warn(f"{what} move vertices by up to {reach:.4g}, {reach / diagonal:.3g} times "
+                 f"the mesh's bounding-box diagonal ({diagonal:.4g}): check the units")
 
 
 def _moved(ctx, spec, rest, base):
