@@ -114,7 +114,10 @@ def _row(label, runs):
 
     first = runs[0]
     its = "/".join(first["iterations"]) if first["iterations"] else "-"
-    peak = med(lambda r: r["max_rss_mb"] * 1.048576e-3)
+    # -v resets the high-water mark per stage, after which ru_maxrss covers the last stage
+    # only: the largest stage peak where there are any
+    peak = med(lambda r: max([*r["stage_peak_gb"].values(), *r["peak_gb"].values(),
+                              r["max_rss_mb"] * 1.048576e-3]))
     cells = [label, str(first["exit"]), fmt(med(lambda r: r["wall_s"]), " s"),
              fmt(peak, " GB"), its]
     for stage in STAGES:

@@ -6,7 +6,8 @@ import pytest
 
 from srarap_cli.runtime import memory
 
-pytestmark = pytest.mark.skipif(memory.start() is None, reason="no /proc high-water mark here")
+pytestmark = pytest.mark.skipif(memory._high_water() is None,
+                                reason="no /proc high-water mark here")
 
 MB = 1 << 20
 
@@ -16,6 +17,8 @@ MB = 1 << 20
 STAGES = """
 import numpy as np
 from srarap_cli.runtime import memory
+assert memory.start() is None  # off until enabled
+memory.enable()
 
 def touch(megabytes):
     block = np.ones(megabytes * (1 << 20) // 8)

@@ -87,6 +87,8 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
         if os.path.abspath(log) == os.path.abspath(out):
             raise click.UsageError("--log and --output name the same file")
     refuse_overwrite([out, log, preview], mesh=mesh, handles=handles)
+    if (verbosity or 0) >= 2:  # -v: peak memory per stage (off otherwise: see runtime.memory)
+        memory.enable()
     peak = memory.start()
     source, source_format = read_any_mesh(mesh, input_format)
     peaks = {"read": memory.stop(peak)}

@@ -6,6 +6,11 @@ it. Stages nest (a coarse level's setup inside the fine level's), so a reset fol
 reached so far into every stage still open before clearing it: each stage's figure is the
 highest resident size between its start and its end, whatever opened or closed inside.
 Elsewhere (no ``/proc``) every figure is None.
+
+Measuring is off until :func:`enable` (``-v`` turns it on): the reset also lowers what the
+kernel reports as the process's peak afterwards (``ru_maxrss``, ``/usr/bin/time``'s maximum
+resident size cover only the time since the last reset), which a run not asking for these
+figures must not have changed under it.
 """
 import itertools
 import threading
@@ -15,6 +20,13 @@ _CLEAR = "/proc/self/clear_refs"
 _open: dict[int, int] = {}
 _ids = itertools.count()
 _lock = threading.Lock()
+_enabled = False
+
+
+def enable() -> None:
+    """Measure from now on (see the module's note on what the reset changes)."""
+    global _enabled
+    _enabled = True
 
 
 def _high_water():
@@ -46,9 +58,10 @@ def _fold():
 
 
 def start() -> int | None:
-    """Open a stage; returns its token (None where peaks cannot be measured)."""
+    """Open a stage; returns its token (None where peaks cannot be measured, or measuring
+    is not enabled)."""
     with _lock:
-        if _high_water() is None:
+        if not _enabled or _high_water() is None:
             return None
         _fold()
         if not _reset():
