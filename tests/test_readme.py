@@ -5,30 +5,40 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from click.testing import CliRunner
 from helpers import ROOT
 
+from srarap_cli.cli import main
 from srarap_cli.io.handles import load_handles
 from srarap_cli.io.mesh import read_mesh
 
 
 @pytest.mark.parametrize("page, heading", [("README.md", "## Handle files"),
                                            ("docs/guides/handle-files.md", "# ")])
-def test_the_complete_handle_example_loads(tmp_path, page, heading):
+def test_the_complete_handle_example_is_the_shipped_one_and_runs_as_pasted(tmp_path, page,
+                                                                          heading):
     text = Path(ROOT, page).read_text(encoding="utf-8")
     section = text[text.index(heading):]
     example = re.search(r"```yaml\n(.*?)```", section, re.DOTALL).group(1)
-    (tmp_path / "handles.yaml").write_text(example)
-    V = read_mesh(os.path.join(ROOT, "sample_meshes", "bar.obj")).vertices
-    z = V[:, 2]
-    groups = np.where((z > 2.4) & (z < 2.6), 2, -1)  # a ring for the 'ears' group
-    (tmp_path / "selection.dmat").write_text(f"1 {len(V)}\n" + "\n".join(map(str, groups)))
-    status = np.where((z > 7.4) & (z < 7.6), 2, 1)  # a ring for the 'paw' group
-    (tmp_path / "shape.sel").write_text("# status\n# per vertex\n" + "\n".join(map(str, status)))
-    (tmp_path / "shape.def").write_text("# move\n1 0 0 5\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
-    c = load_handles(str(tmp_path / "handles.yaml"), V, fps=24)
+    shipped = Path(ROOT, "configs", "handles-reference.yaml").read_text(encoding="utf-8")
+    assert shipped.endswith(example)  # after its header comment
+    # pasted into a samples folder, beside the files it names, it runs as written
+    assert CliRunner().invoke(main, ["samples", str(tmp_path / "s")]).exit_code == 0
+    pasted = tmp_path / "s" / "configs" / "pasted.yaml"
+    pasted.write_text(example)
+    bar = str(tmp_path / "s" / "sample_meshes" / "bar.obj")
+    V = read_mesh(bar).vertices
+    c = load_handles(str(pasted), V, fps=24)
     assert set(c.groups) == {"base", "tip", "ears", "paw", "tail"}
     assert c.solver["alpha"] == 0.14 and c.region is not None and len(c.tracks) == 1
-    assert all(len(ids) for ids in c.groups.values())
+    # the files select what their comments say: the rings at z = 6.5 (ears) and z = 8 (paw)
+    assert np.allclose(V[c.groups["ears"], 2], 6.5) and len(c.groups["ears"]) == 16
+    assert np.allclose(V[c.groups["paw"], 2], 8.0) and len(c.groups["paw"]) == 16
+    out = tmp_path / "out.obj"
+    r = CliRunner().invoke(main, ["deform", bar, str(pasted), "-o", str(out), "--strict"])
+    assert r.exit_code == 0, r.stderr  # and no warning (--strict)
+    moved = read_mesh(str(out)).vertices
+    assert np.allclose(moved[c.ids], c.targets, atol=1e-9)
 
 
 def test_the_tour_runs_as_written(tmp_path):

@@ -55,7 +55,7 @@ def bench(mesh: str, handles: str, methods: str, time_budget: float, out: str | 
         _prepare_folder(out)
     source = read_mesh(mesh)
     check_solve(mesh, len(source.vertices))
-    constraints = load_handles(handles, source.vertices)
+    constraints = load_handles(handles, source.vertices, any_rate=True)
     opts = resolve(constraints.solver, OWN_DEFAULTS, overrides)
     p = problem(source, constraints, mesh)
     runs = run_methods(p.V, p.F, p.ids, p.targets, names, settings=opts,

@@ -1,4 +1,5 @@
 """What every subcommand shares: error-to-exit-code mapping and output preflight."""
+import dataclasses
 import functools
 import math
 import os
@@ -11,7 +12,7 @@ from typing import Any, NoReturn
 import click
 import numpy as np
 
-from ..io.handles import referenced_files
+from ..io.handles import Constraints, load_handles, referenced_files
 from ..io.mesh import FORMATS, MeshFormat, read_mesh
 from ..io.mesh.formats import by_extension
 from ..io.mesh.mesh import Mesh
@@ -232,6 +233,27 @@ class MeshFormatType(click.ParamType):
 input_format_option = click.option(
     "--input-format", type=MeshFormatType(),
     help="Format of a mesh given as '-' (standard input). [default: told from its bytes]")
+
+
+def pose_options(func: Callable[..., None]) -> Callable[..., None]:
+    """``--fps`` and ``--frame``: which pose of a keyframed handle file a single solve takes."""
+    func = click.option("--frame", type=click.FloatRange(min=0), default=0.0, show_default=True,
+                        callback=finite_option,
+                        help="Pose of keyframed groups at this frame (fractional frames "
+                             "interpolate).")(func)
+    return click.option("--fps", type=click.FloatRange(min=0, min_open=True),
+                        callback=finite_option,
+                        help="Frames per second, for keyframes given by time (needed with "
+                             "--frame unless every key gives its frame).")(func)
+
+
+def load_posed(handles: str, V: np.ndarray, fps: float | None, frame: float) -> Constraints:
+    """The constraints of ``handles`` with keyframed groups at ``frame``. Frame 0 is time 0
+    at any frame rate, so its pose needs no ``--fps`` even where keys give times."""
+    constraints = load_handles(handles, V, fps=fps, any_rate=frame == 0)
+    if frame == 0 or not constraints.tracks:
+        return constraints
+    return dataclasses.replace(constraints, targets=constraints.targets_at(frame))
 
 
 cache_option = click.option("--cache", type=click.Path(file_okay=False),

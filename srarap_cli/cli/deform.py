@@ -6,7 +6,6 @@ from typing import Any
 
 import click
 
-from ..io.handles import load_handles
 from ..io.mesh import FORMATS
 from ..io.mesh.formats import MeshFormat, by_extension, extensions
 from ..io.solve_log import LOG_FORMATS, format_log
@@ -26,6 +25,8 @@ from .common import (
     check_output_path,
     guarded,
     input_format_option,
+    load_posed,
+    pose_options,
     read_any_mesh,
     refuse_overwrite,
     report,
@@ -60,12 +61,14 @@ from .progress import SolveProgress
               help="Add a per-vertex 'distortion' property to PLY output.")
 @click.option("--keep-unconverged", is_flag=True,
               help="Write the mesh even when the solve did not converge (exit code still 3).")
+@pose_options
 @with_verbosity
 @guarded
 def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
            out_format: MeshFormat | None, ascii: bool, log: str | None,
            overrides: dict[str, Any], cache: str | None, preview: str | None, preview_up: str,
-           write_distortion: bool, keep_unconverged: bool, verbosity: int | None) -> None:
+           write_distortion: bool, keep_unconverged: bool, fps: float | None, frame: float,
+           verbosity: int | None) -> None:
     """Deform MESH as rigidly as possible with smooth rotations.
 
     HANDLES is a YAML/JSON handle file, or a Botsch-Sorkine .sel file with its .def beside it.
@@ -97,7 +100,7 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
         _check_format_options(fmt, ascii, write_distortion)
     name = "<stdin>" if mesh == "-" else mesh
     check_solve(name, len(source.vertices))
-    constraints = load_handles(handles, source.vertices)
+    constraints = load_posed(handles, source.vertices, fps, frame)
     opts = resolve(constraints.solver, overrides)
     progress = SolveProgress(enabled=verbosity != 0 and sys.stderr.isatty())
     peak = memory.start()

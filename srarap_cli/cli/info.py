@@ -3,10 +3,9 @@ import json
 
 import click
 
-from ..io.handles import load_handles
 from ..io.mesh.formats import MeshFormat
 from ..tasks.info import handles_info, mesh_info
-from .common import guarded, input_format_option, read_any_mesh
+from .common import guarded, input_format_option, load_posed, pose_options, read_any_mesh
 
 
 @click.command("info")
@@ -14,9 +13,10 @@ from .common import guarded, input_format_option, read_any_mesh
 @click.argument("handles", required=False)
 @input_format_option
 @click.option("--json", "as_json", is_flag=True, help="One JSON document on standard output.")
+@pose_options
 @guarded
 def info(mesh: str, handles: str | None, input_format: MeshFormat | None,
-         as_json: bool) -> None:
+         as_json: bool, fps: float | None, frame: float) -> None:
     """Describe MESH and what HANDLES selects and does, without solving.
 
     The mesh: counts, extent per axis, problems. With HANDLES, each group's vertices and
@@ -27,7 +27,7 @@ def info(mesh: str, handles: str | None, input_format: MeshFormat | None,
     out = {"mesh": name, **mesh_info(source)}
     if handles is not None:
         out["handles"] = handles
-        out.update(handles_info(source, load_handles(handles, source.vertices), name))
+        out.update(handles_info(source, load_posed(handles, source.vertices, fps, frame), name))
     if as_json:
         click.echo(json.dumps(out, indent=2))
     else:

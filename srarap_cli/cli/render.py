@@ -62,7 +62,8 @@ def render(mesh: str, out: str, handles: str | None, rest: str | None, color: st
         raise click.BadParameter("the rest mesh must have the same vertices", param_hint="--rest")
     if color == "distortion" and base is None:
         raise click.UsageError("--color distortion needs --rest")
-    constraints = load_handles(handles, (base or shown).vertices) if handles else None
+    constraints = (load_handles(handles, (base or shown).vertices, any_rate=True) if handles
+                   else None)
     commit_files([(out, preview_png(shown, base, constraints, color, layout, list(views),
                                     size, up))])
 

@@ -58,7 +58,9 @@ def handles_info(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> di
     for g, ids in constraints.groups.items():
         track = next((t for s, _, t in constraints.tracks
                       if np.array_equal(constraints.ids[s], ids)), None)
-        action = (f"keyframed ({len(track.frames)} keys, last at frame {track.frames[-1]:g})"
+        action = ("keyframed, keys given by time (the pose at frame 0 is checked; --fps "
+                  "places the others)" if track is not None and track.first_only else
+                  f"keyframed ({len(track.frames)} keys, last at frame {track.frames[-1]:g})"
                   if track is not None else
                   describe_motion(mesh.vertices[ids], constraints.targets[slots[g]]))
         groups.append({"name": g, "vertices": int(len(ids)), "action": action})

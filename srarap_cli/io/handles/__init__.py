@@ -97,7 +97,7 @@ def as_constraints(handles: Any, V: np.ndarray) -> "Constraints":
 
 
 def load_handles(path: str | os.PathLike, V: np.ndarray,
-                 fps: float | None = None) -> "Constraints":
+                 fps: float | None = None, any_rate: bool = False) -> "Constraints":
     """Read and validate a handle file against rest positions ``V`` (n, 3).
 
     Parameters
@@ -105,6 +105,8 @@ def load_handles(path: str | os.PathLike, V: np.ndarray,
     path : str, ``.yaml``/``.yml``, ``.json`` or ``.sel``
     V : (n, 3) float array
     fps : float, optional; frames per second, for keyframes given by ``time``
+    any_rate : bool, only the pose at frame 0 is wanted: ``time`` keys need no ``fps``
+        (keyframed groups then keep their first key alone)
 
     Returns
     -------
@@ -116,7 +118,7 @@ def load_handles(path: str | os.PathLike, V: np.ndarray,
     if path.lower().endswith(".sel"):
         return _from_sel(path, V)
     return parse_handles(_load_document(path), V, path, os.path.dirname(os.path.abspath(path)),
-                         fps)
+                         fps, any_rate)
 
 
 def _load_document(path):
@@ -127,7 +129,7 @@ def _load_document(path):
 
 
 def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = ".",
-                  fps: float | None = None) -> "Constraints":
+                  fps: float | None = None, any_rate: bool = False) -> "Constraints":
     """Validate an already-loaded handle document (dict) against ``V``; see :func:`load_handles`."""
     ctx = Context(path)
     doc = ctx.mapping(doc, "the handle file", TOP_KEYS)
@@ -143,11 +145,11 @@ def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = 
         names.append(str(name))
         ids.append(sel)
         if "keyframes" in spec:
-            track = tracks[str(name)] = parse_track(gctx, spec, V[sel], fps)
+            track = tracks[str(name)] = parse_track(gctx, spec, V[sel], fps, any_rate)
             tgts.append(track.apply(V[sel], 0.0))
-            for frame in track.frames:
+            for k, frame in enumerate(track.frames):
                 check_reach(gctx, V[sel], track.apply(V[sel], float(frame)), diagonal,
-                            f"its keyframe at frame {float(frame):g}")
+                            f"its keyframe {k}")
         else:
             if "easing" in spec:
                 raise gctx.error("easing only applies together with keyframes")

@@ -24,6 +24,8 @@ class Track:
     rotations : (k, 4) float array, unit quaternions, each on the hemisphere of the one before
     pivot : (3,) float array
     easing : str, one of EASINGS
+    first_only : bool, the keys given by time were left out (no frame rate): the track holds
+        the pose at frame 0 only
     """
 
     frames: np.ndarray
@@ -31,6 +33,7 @@ class Track:
     rotations: np.ndarray
     pivot: np.ndarray
     easing: str = "linear"
+    first_only: bool = False
 
     def transform(self, frame: float) -> tuple[np.ndarray, np.ndarray]:
         """Rotation matrix (3, 3) and translation (3,) at ``frame``."""
