@@ -138,8 +138,11 @@ def test_usage_and_output_errors(small, tmp_path):
     mesh, handles = small
     assert run(mesh, handles, "-o", tmp_path / "o.vtk").exit_code == 2
     assert run(mesh, handles, "-o", tmp_path / "o.obj", "--alpha", "0").exit_code == 2
-    r = run(mesh, handles, "-o", tmp_path / "no" / "such" / "dir.obj")
-    assert r.exit_code == 6 and "does not exist" in r.stderr
+    r = run(mesh, handles, "-o", tmp_path / "new" / "folders" / "o.obj")  # made, as animate's
+    assert r.exit_code == 0 and (tmp_path / "new" / "folders" / "o.obj").is_file()
+    (tmp_path / "file").write_text("x")
+    r = run(mesh, handles, "-o", tmp_path / "file" / "sub" / "o.obj")
+    assert r.exit_code == 6 and "is a file, not a folder" in r.stderr
 
 
 def test_existing_output_survives_a_failed_run(small, tmp_path):

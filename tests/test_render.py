@@ -99,13 +99,13 @@ def test_deform_preview_distortion_ply_and_plot(tmp_path):
 def test_several_views_are_drawn_side_by_side(tmp_path):
     out = tmp_path / "v.png"
     r = invoke("render", BAR, "--handles", BEND, "--view", "front", "--view", "top",
-               "--size", "600x300", "-o", out)
+               "--size", "600x300", "-o", out, "--up", "y")
     assert r.exit_code == 0, r.output
     img = picture(out)
     left, right = img[:, :300, :3], img[:, 300:, :3]
     assert left.std() > 0.05 and right.std() > 0.05
-    # y up (the default): the bar's long axis z points at a front view, which sees the tip
-    # cap (blue) as a disc; from the top only a band of it shows
+    # y up: the bar's long axis z points at a front view, which sees the tip cap (blue) as
+    # a disc; from the top only a band of it shows
     blue = near(img, PALETTE[1], 0.35)
     assert blue[:, :300].sum() > 3 * blue[:, 300:].sum()
 
@@ -127,3 +127,16 @@ def test_the_up_axis_is_drawn_upward(tmp_path, up, tall):
         np.flatnonzero((img < 0.95).any(axis=2).any(axis=0))
     height, width = np.ptp(ink[0]), np.ptp(ink[1])
     assert (height > 2 * width) == tall  # otherwise the long axis points at the camera
+
+
+def test_the_default_up_axis_stands_the_sample_bar_on_its_base(tmp_path):
+    # --up auto is info's guess: z for the bar (ten times as long as wide), so the front
+    # view shows it upright, taller than wide, its tip (blue) above its base (red)
+    out = tmp_path / "a.png"
+    r = invoke("render", BAR, "--handles", BEND, "--view", "front", "-o", out)
+    assert r.exit_code == 0, r.output
+    img = picture(out)
+    blue, red = near(img, PALETTE[1], 0.35), near(img, PALETTE[0], 0.35)
+    tip, base = np.argwhere(blue).mean(axis=0), np.argwhere(red).mean(axis=0)  # (row, col)
+    assert base[0] - tip[0] > 0.6 * img.shape[0]  # tip far above the base: upright
+    assert abs(base[1] - tip[1]) < 0.05 * img.shape[1]  # one above the other

@@ -129,15 +129,19 @@ def _classify(exc):
 
 def check_output_path(path: str, allowed: Sequence[str] | None, what: str) -> None:
     """Fail before any work when an output could not be written (``allowed``: its
-    extensions; None when the format is given otherwise)."""
+    extensions; None when the format is given otherwise). A missing folder is not a failure:
+    every command makes the missing folders of its outputs when it writes them."""
     ext = os.path.splitext(path)[1].lower()
     if allowed is not None and ext not in allowed:
         raise click.UsageError(f"{what} {path!r}: extension must be one of {', '.join(allowed)}")
     folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise OutputError(f"{path}: folder {folder} does not exist")
-    if not os.access(folder, os.W_OK):
-        raise OutputError(f"{path}: folder {folder} is not writable")
+    existing = folder
+    while not os.path.exists(existing):  # missing folders are made when the files are written
+        existing = os.path.dirname(existing)
+    if not os.path.isdir(existing):
+        raise OutputError(f"{path}: {existing} is a file, not a folder")
+    if not os.access(existing, os.W_OK):
+        raise OutputError(f"{path}: folder {existing} is not writable")
     if os.path.isdir(path):
         raise OutputError(f"{path}: is a folder")
 

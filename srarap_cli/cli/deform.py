@@ -17,6 +17,7 @@ from ..solver.multires.size import AUTO_THRESHOLD
 from ..solver.settings import resolve
 from ..solver.stop import StopReason
 from ..tasks.distortion import vertex_distortion
+from ..tasks.info import up_axis
 from ..tasks.pipeline import deform_mesh, refuse_warnings
 from ..tasks.preview import preview_png
 from .common import (
@@ -55,7 +56,8 @@ from .progress import SolveProgress
 @settings_options()
 @cache_option
 @click.option("--preview", help="Also write a PNG: rest and deformed shape, handles coloured.")
-@click.option("--preview-up", type=click.Choice(["y", "z", "x", "-y", "-z", "-x"]), default="y",
+@click.option("--preview-up", type=click.Choice(["auto", "y", "z", "x", "-y", "-z", "-x"]),
+              default="auto",
               show_default=True, help="The mesh's axis drawn upward in --preview.")
 @click.option("--write-distortion", is_flag=True,
               help="Add a per-vertex 'distortion' property to PLY output.")
@@ -120,7 +122,8 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
     files = [(out, mesh_bytes)] if keep and out != "-" else []
     if preview is not None and keep:
         files.append((preview, preview_png(deformed, source, constraints, view="iso",
-                                                  up=preview_up)))
+                                                  up=up_axis(source) if preview_up == "auto"
+                                                  else preview_up)))
     if log is not None:
         files.append((log, format_log(result.log, os.path.splitext(log)[1].lower()).encode()))
     if keep and out == "-":  # first: the files are committed only once it was written

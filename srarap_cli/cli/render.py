@@ -11,6 +11,7 @@ from ..io.handles import load_handles
 from ..io.mesh import read_mesh
 from ..io.mesh.formats import MeshFormat
 from ..runtime.commit import commit_files
+from ..tasks.info import up_axis
 from ..tasks.preview import preview_png
 from ..tasks.render import VIEWS
 from .common import check_output_path, guarded, input_format_option, read_any_mesh, refuse_overwrite
@@ -37,10 +38,11 @@ def parse_size(text: str) -> tuple[int, int]:
 @click.option("--layout", type=click.Choice(["ghost", "side"]), default="ghost",
               show_default=True,
               help="Rest shape ghosted behind the mesh (small deformations show), or beside it.")
-@click.option("--up", type=click.Choice(["y", "z", "x", "-y", "-z", "-x"]), default="y",
-              show_default=True,
-              help="The mesh's axis drawn upward: y for most OBJ/PLY files (and the samples), "
-                   "z for CAD and scanner data.")
+@click.option("--up", type=click.Choice(["auto", "y", "z", "x", "-y", "-z", "-x"]),
+              default="auto", show_default=True,
+              help="The mesh's axis drawn upward: auto is the guess 'srarap info' prints (y or "
+                   "z: the length of a long object, else the side it stands on); y for most "
+                   "OBJ/PLY files, z for CAD and scanner data.")
 @click.option("--view", "views", multiple=True, default=("iso",), show_default=True,
               help=f"{', '.join(VIEWS)}, or a viewing direction 'x,y,z'; repeat for "
                    "several views side by side.")
@@ -64,6 +66,8 @@ def render(mesh: str, out: str, handles: str | None, rest: str | None, color: st
         raise click.UsageError("--color distortion needs --rest")
     constraints = (load_handles(handles, (base or shown).vertices, any_rate=True) if handles
                    else None)
+    if up == "auto":
+        up = up_axis(base or shown)
     commit_files([(out, preview_png(shown, base, constraints, color, layout, list(views),
                                     size, up))])
 
@@ -98,12 +102,15 @@ def plot(logs: tuple[str, ...], out: str, size: str) -> None:
 
     tables = [(path, _read_log(path)) for path in logs]  # every log checked before drawing
     fig, (a, b) = plt.subplots(1, 2, figsize=(w / 100, h / 100), dpi=100)
+    times = []
     for path, rows in tables:
         it = [float(r["iteration"]) for r in rows]
         e = [float(r["total"]) for r in rows]
         t = [max(float(r["seconds"]), 1e-4) for r in rows]
+        times += t
         a.semilogy(it, e, label=os.path.basename(path))
-        b.loglog(t, e, label=os.path.basename(path))
+        b.semilogy(t, e, label=os.path.basename(path))
+    _time_axis(b, times)
     for ax, xl in ((a, "iteration"), (b, "wall time [s]")):
         ax.set_xlabel(xl)
         ax.set_ylabel("total energy")
@@ -114,6 +121,18 @@ def plot(logs: tuple[str, ...], out: str, size: str) -> None:
     fig.savefig(buf, format="png", metadata={"Software": None})
     plt.close(fig)
     commit_files([(out, buf.getvalue())])
+
+
+def _time_axis(ax, times):
+    """Seconds on a log axis when they span more than a decade, labelled at its powers of
+    ten only (the minor ticks' labels ran into each other); a linear axis otherwise."""
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    if not times or max(times) < 10 * min(times):
+        return
+    ax.set_xscale("log")
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 def _read_log(path):

@@ -35,8 +35,11 @@ def commit_files(files: list[tuple[str, bytes]]) -> None:
     one was staged and before any is renamed, so a failed write through (``/dev/full``)
     leaves every regular target as it was.
     """
-    staged = []
+    staged: list = []
+    made: list[str] = []  # folders this commit made, to remove again should it fail
+    done = False
     try:
+        _make_folders([path for path, _ in files], made)
         through = []
         for path, data in files:
             if _writes_through(path):
@@ -51,11 +54,36 @@ def commit_files(files: list[tuple[str, bytes]]) -> None:
         blocked = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
         try:
             _replace_all(staged)
+            done = True
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
     finally:
         for tmp, _ in staged:
             _remove(tmp)
+        if not done:
+            _remove_folders(made)
+
+
+def _make_folders(paths, made):
+    """Make the missing folders of ``paths`` (every command's rule: an output's folder is
+    made when it is written), each added to ``made`` as it is made."""
+    for path in paths:
+        folder = os.path.dirname(os.path.abspath(path))
+        missing = []
+        while not os.path.exists(folder):
+            missing.append(folder)
+            folder = os.path.dirname(folder)
+        for folder in reversed(missing):
+            _named(folder, os.mkdir, folder)
+            made.append(folder)
+
+
+def _remove_folders(made):
+    for folder in reversed(made):  # deepest first
+        try:
+            os.rmdir(folder)
+        except OSError:  # not empty after all: something else wrote there
+            pass
 
 
 def _replace_all(staged):

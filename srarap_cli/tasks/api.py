@@ -36,9 +36,13 @@ def deform(mesh: Any, handles: Any, *arrays: Any,
 
     Returns
     -------
-    DeformResult, with ``faces`` set: ``result.to_arrays()``, ``result.to_trimesh()``,
-    ``result.to_meshio()``; ``result.warnings`` lists what the input deserved a warning for
+    DeformResult
+        With ``faces`` set: ``result.to_arrays()``, ``result.to_trimesh()``,
+        ``result.to_meshio()``; ``result.warnings`` lists what the input deserved a warning
+        for.
 
+    Notes
+    -----
     The array form ``deform(V, F, constrained, targets, initial=..., ...)`` of
     :func:`srarap_cli.solver.oneshot.deform` is accepted too (a warm start needs it, or a
     :class:`~srarap_cli.solver.deformer.Deformer`).

@@ -14,6 +14,12 @@ from .pipeline import problem
 AXES = "xyz"
 
 
+def up_axis(mesh: Mesh) -> str:
+    """The axis ``render`` draws upward by default: ``y`` or ``z``, :func:`mesh_info`'s
+    guess (``up_guess`` without its sign)."""
+    return _up_guess(mesh.vertices, mesh.triangles()[0])[1:]
+
+
 def mesh_info(mesh: Mesh) -> dict:
     """Counts, extent and problems of ``mesh``.
 
@@ -160,12 +166,18 @@ def _boundary_loops(F):
 
 
 def _up_guess(V, F):
-    """y or z, whichever the mesh more likely stands on: the one whose lowest slab carries
-    more downward-facing area (a base, feet, a bottom); y on a tie, as most OBJ and PLY
-    files are y-up. A guess, and said to be one: a lying cylinder fools it."""
+    """y or z, whichever the mesh more likely stands on. An object at least twice as long
+    along one of them as across (a bar, a column, a standing figure) stands on its length;
+    otherwise the axis whose lowest slab carries more downward-facing area (a base, feet, a
+    bottom); y on a tie, as most OBJ and PLY files are y-up. A guess, and said to be one: a
+    lying cylinder fools it."""
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    extent = hi - lo
+    for k in (1, 2):
+        if extent[k] >= 2 * max(extent[j] for j in range(3) if j != k):
+            return "+" + AXES[k]
     normals = triangle_normals(V, F) / 2
     centers = V[F].mean(axis=1)
-    lo, hi = V.min(axis=0), V.max(axis=0)
     scores = {}
     for k in (1, 2):
         low = centers[:, k] <= lo[k] + 0.05 * (hi[k] - lo[k])

@@ -54,4 +54,6 @@ def preview_png(mesh: Mesh, rest: Mesh | None = None, constraints: Constraints |
     note = "extent " + ", ".join(f"{a} {e:.4g}" for a, e in zip("xyz", extent))
     legend = list(constraints.groups) if constraints is not None and color != "distortion" \
         else None
-    return render_png(panels, size, view, colorbar, legend=legend, axes=turn, note=note)
+    titles = ["rest", "deformed"] if len(panels) == 2 else None
+    return render_png(panels, size, view, colorbar, legend=legend, axes=turn, note=note,
+                      titles=titles)

@@ -104,7 +104,8 @@ def face_colors(F: np.ndarray, vertex_groups: Sequence[np.ndarray] | None = None
 
 def render_png(panels: list, size: tuple[int, int] = (800, 600),
                view: str | Sequence[str] = "iso", colorbar: Any = None,
-               legend: Any = None, axes: Any = None, note: str | None = None) -> bytes:
+               legend: Any = None, axes: Any = None, note: str | None = None,
+               titles: Sequence[str] | None = None) -> bytes:
     """PNG bytes of one or more panels side by side, for one or more views.
 
     Parameters
@@ -118,6 +119,8 @@ def render_png(panels: list, size: tuple[int, int] = (800, 600),
     axes : (3, 3) float array, optional, the model's x, y, z axes in the renderer's frame:
         a triad in the lower left corner of each view shows them
     note : str, optional, a line of text at the bottom (e.g. the mesh's extent)
+    titles : list of str, optional, one per panel ("rest", "deformed"); with several views
+        each column's label also names its view
     """
     import matplotlib
     matplotlib.use("Agg")
@@ -131,14 +134,21 @@ def render_png(panels: list, size: tuple[int, int] = (800, 600),
     triad = axes
     views = [view] if isinstance(view, str) else list(view)
     columns = len(views) * len(panels)
+    labelled = bool(titles) or len(views) > 1
+    top = 0.92 if labelled else 1.0  # room above the panels for their labels
     for v, name in enumerate(views):
         boxes, axes = [], []
         for k, meshes in enumerate(panels):
             col = v * len(panels) + k
-            ax = fig.add_axes((col * width / columns, 0, width / columns, 1))
+            ax = fig.add_axes((col * width / columns, 0, width / columns, top))
             ax.set_axis_off()
             boxes += [draw(ax, V, F, c, name, a) for V, F, c, a in meshes]
             axes.append(ax)
+            label = ", ".join(([titles[k]] if titles else []) + ([name] if len(views) > 1
+                                                                 else []))
+            if label:
+                fig.text((col + 0.5) * width / columns, 0.965, label, ha="center", va="top",
+                         fontsize=9, color="0.2")
         _frame(axes, boxes)
         if triad is not None:
             _triad(fig, v * len(panels) * width / columns, name, triad)

@@ -1,0 +1,76 @@
+"""MkDocs hooks: the command-line reference's Default column.
+
+mkdocs-click prints Click's ``Sentinel.UNSET`` for an option without a default. Every srarap
+option of that kind either says its default in its help (``[default: 0.14]``: the solver
+settings, whose value comes from the handle file or the defaults) or is a flag or has none;
+the column gets that default, ``off`` for a flag, and ``-`` otherwise.
+"""
+import re
+
+ROW = re.compile(r"<tr>\s*<td>(?P<name>.*?)</td>\s*<td>(?P<type>.*?)</td>\s*"
+                 r"<td>(?P<help>.*?)</td>\s*<td><code>Sentinel\.UNSET</code></td>\s*</tr>",
+                 re.DOTALL)
+SAID = re.compile(r"\[default: (?P<value>[^\]]*)\]")
+
+
+def _row(match):
+    said = SAID.search(match["help"])
+    if said:
+        default = f"<code>{said['value']}</code>"
+    elif match["type"].strip() == "boolean":
+        default = "off"
+    else:
+        default = "-"
+    return (f"<tr>\n<td>{match['name']}</td>\n<td>{match['type']}</td>\n"
+            f"<td>{match['help']}</td>\n<td>{default}</td>\n</tr>")
+
+
+def on_page_content(html, page, config, files):
+    if "Sentinel." not in html:
+        return html
+    return ROW.sub(_row, html)
+
+
+# The API reference: the docstrings are numpydoc written for readers of the source, where
+# ``name : what it is`` often says more than a type and Sphinx roles name other objects.
+ROLE = re.compile(r":(?:func|meth|class|mod|attr|data|exc|obj):(?:<code>|`)~?([\w.]+)(?:</code>|`)")
+DOUBLED = re.compile(r"``([^`]*)``")
+TYPE_CELL = re.compile(r'(<tr class="doc-section-item">\s*<td>\s*<code>[^<]*</code>\s*</td>\s*)'
+                       r"<td>\s*<code>(?P<type>[^<]*)</code>\s*</td>\s*"
+                       r'<td>\s*<div class="doc-md-description">\s*(?P<desc>.*?)\s*</div>',
+                       re.DOTALL)
+#: a "type" this long, or with words a type does not have, is the start of a description
+TYPE_WORDS = re.compile(r"\b(the|a|an|of|or|and|from|for|in|with|to|each|one|per)\b")
+
+
+def _short(match):
+    """A role's target by its last name (``~`` or not): the page says where it lives."""
+    return f"<code>{match[1].rsplit('.', 1)[-1]}</code>"
+
+
+def _type_cell(match):
+    kind = match["type"]
+    if len(kind) <= 40 and not TYPE_WORDS.search(kind):
+        return match[0]
+    desc = match["desc"]
+    if desc.startswith("<p>"):
+        desc = f"<p>{kind} {desc[3:]}"
+    else:
+        desc = f"<p>{kind}</p>{desc}"
+    return (f"{match[1]}<td></td>\n<td>\n<div class=\"doc-md-description\">{desc}</div>")
+
+
+def _api(html):
+    html = TYPE_CELL.sub(_type_cell, html)
+    html = ROLE.sub(_short, html)
+    return DOUBLED.sub(r"\1", html)
+
+
+_on_cli = on_page_content
+
+
+def on_page_content(html, page, config, files):  # noqa: F811 (both pages' fixes)
+    html = _on_cli(html, page, config, files)
+    if page.file.src_uri == "reference/api.md":
+        html = _api(html)
+    return html
