@@ -101,7 +101,7 @@ def test_sel_file_alone_uses_the_def_beside_it(tmp_path):
     ({"tip": {"indices": [0], "fixd": True}}, "group 'tip': unknown key 'fixd'"),
     ({"tip": {"indices": [100000], "fixed": True}}, "group 'tip': indices: vertex 100000 out of range"),
     ({"tip": {"box": {"min": [9, 9, 9], "max": [10, 10, 10]}, "fixed": True}},
-     "group 'tip': selects no vertex"),
+     "group 'tip': selects no vertex (box [9, 9, 9]..[10, 10, 10]); the mesh spans x "),
     ({"tip": {"indices": [0]}}, "group 'tip': no action"),
     ({"tip": {"fixed": True}}, "group 'tip': no selector"),
     ({"tip": {"indices": [0], "fixed": True, "translate": [1, 0, 0]}}, "cannot be combined"),

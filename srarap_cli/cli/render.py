@@ -11,6 +11,8 @@ from ..io.handles import load_handles
 from ..io.mesh import read_mesh
 from ..io.mesh.formats import MeshFormat
 from ..runtime.commit import commit_files
+from ..runtime.errors import InputError
+from ..tasks.frames import animated_gif, contact_sheet, frame_pictures, sheet_choice
 from ..tasks.info import up_axis
 from ..tasks.preview import preview_png
 from ..tasks.render import VIEWS
@@ -46,14 +48,25 @@ def parse_size(text: str) -> tuple[int, int]:
 @click.option("--view", "views", multiple=True, default=("iso",), show_default=True,
               help=f"{', '.join(VIEWS)}, or a viewing direction 'x,y,z'; repeat for "
                    "several views side by side.")
-@click.option("--size", default="800x600", show_default=True, help="WIDTHxHEIGHT in pixels.")
+@click.option("--size", help="WIDTHxHEIGHT in pixels (of each frame, for a frame pattern). "
+                                "[default: 800x600; 480x360 a frame]")
+@click.option("--fps", type=click.FloatRange(min=1, max=50), default=12.0, show_default=True,
+              help="Frames per second of an animated GIF.")
 @input_format_option
 @guarded
 def render(mesh: str, out: str, handles: str | None, rest: str | None, color: str, layout: str,
-           up: str, views: tuple[str, ...], size: str, input_format: MeshFormat | None) -> None:
-    """Render MESH to a PNG, headless."""
+           up: str, views: tuple[str, ...], size: str | None, fps: float,
+           input_format: MeshFormat | None) -> None:
+    """Render MESH to a PNG, headless.
+
+    MESH may be an animation's frame pattern (as 'srarap animate' writes: 'frames/f_{:04d}.obj'):
+    its frames from 0 on, framed alike, become an animated GIF (-o anim.gif) or a contact sheet
+    of up to 24 of them (-o sheet.png).
+    """
+    if "{" in mesh:
+        return _frames(mesh, out, handles, rest, color, layout, up, views, size, fps)
     check_output_path(out, (".png",), "output")
-    size = parse_size(size)
+    size = parse_size(size or "800x600")
     for view in views:
         _check_view(view)
     refuse_overwrite([out], mesh=mesh, handles=handles,
@@ -70,6 +83,52 @@ def render(mesh: str, out: str, handles: str | None, rest: str | None, color: st
         up = up_axis(base or shown)
     commit_files([(out, preview_png(shown, base, constraints, color, layout, list(views),
                                     size, up))])
+
+
+#: a frame pattern's frames at most (a GIF or sheet of more is a mistake, and slow)
+MAX_FRAMES = 10_000
+
+
+def _frames(pattern, out, handles, rest, color, layout, up, views, size, fps):
+    """``render`` of a frame pattern: an animated GIF or a contact sheet."""
+    check_output_path(out, (".gif", ".png"), "output")
+    if rest or color != "shade" or layout != "ghost" or len(views) > 1:
+        raise click.UsageError("a frame pattern takes --handles, --view (one), --up, --size "
+                               "and --fps; not --rest, --color, --layout or several views")
+    _check_view(views[0])
+    size = parse_size(size or "480x360")
+    paths = _frame_files(pattern)
+    refuse_overwrite([out], handles=handles, others=[("frame", p) for p in paths])
+    meshes = [read_mesh(p) for p in paths]
+    if any(len(m.vertices) != len(meshes[0].vertices) for m in meshes):
+        raise InputError(f"{pattern}: the frames do not all have the same vertices")
+    constraints = (load_handles(handles, meshes[0].vertices, any_rate=True) if handles
+                   else None)
+    up = up_axis(meshes[0]) if up == "auto" else up
+    numbers = list(range(len(paths)))
+    if out.lower().endswith(".png"):
+        numbers = sheet_choice(len(paths))
+        meshes = [meshes[k] for k in numbers]
+    pictures = frame_pictures(meshes, numbers, constraints, views[0], size, up)
+    data = animated_gif(pictures, fps) if out.lower().endswith(".gif") else \
+        contact_sheet(pictures)
+    commit_files([(out, data)])
+
+
+def _frame_files(pattern):
+    """The files of a frame pattern from frame 0 up to the first missing one."""
+    try:
+        paths = []
+        while os.path.isfile(pattern.format(len(paths))):
+            paths.append(pattern.format(len(paths)))
+            if len(paths) > MAX_FRAMES:
+                raise InputError(f"{pattern}: more than {MAX_FRAMES} frames")
+    except (IndexError, KeyError, ValueError) as exc:
+        raise click.BadParameter(f"{pattern!r}: not a frame pattern with one field like "
+                                 f"'{{:04d}}' ({exc})", param_hint="MESH") from None
+    if not paths:
+        raise InputError(f"{pattern}: no frame 0 ({pattern.format(0)} does not exist)")
+    return paths
 
 
 def _check_view(view):

@@ -22,9 +22,12 @@ CLIP_PERCENTILE = 99
 
 def preview_png(mesh: Mesh, rest: Mesh | None = None, constraints: Constraints | None = None,
                 color: str = "shade", layout: str = "ghost", view: str | Sequence[str] = "iso",
-                size: tuple[int, int] = (800, 600), up: str = "y") -> bytes:
+                size: tuple[int, int] = (800, 600), up: str = "y",
+                framed: np.ndarray | None = None, caption: str | None = None) -> bytes:
     """PNG bytes of ``mesh`` (and its ``rest`` shape), handles coloured or distortion mapped;
-    ``up`` names the mesh's axis drawn upward (OBJ's convention, y, by default)."""
+    ``up`` names the mesh's axis drawn upward (OBJ's convention, y, by default); ``framed``
+    (p, 3): points the picture's frame holds too (model coordinates); ``caption``: a text
+    before the extent at the bottom."""
     turn = UP[up].T
     mesh = mesh.with_vertices(mesh.vertices @ turn)
     rest = None if rest is None else rest.with_vertices(rest.vertices @ turn)
@@ -52,8 +55,10 @@ def preview_png(mesh: Mesh, rest: Mesh | None = None, constraints: Constraints |
     lo, hi = mesh.vertices.min(axis=0) @ turn.T, mesh.vertices.max(axis=0) @ turn.T
     extent = np.abs(hi - lo)
     note = "extent " + ", ".join(f"{a} {e:.4g}" for a, e in zip("xyz", extent))
+    if caption:
+        note = f"{caption}; {note}"
     legend = list(constraints.groups) if constraints is not None and color != "distortion" \
         else None
     titles = ["rest", "deformed"] if len(panels) == 2 else None
     return render_png(panels, size, view, colorbar, legend=legend, axes=turn, note=note,
-                      titles=titles)
+                      titles=titles, framed=None if framed is None else framed @ turn)

@@ -105,7 +105,8 @@ def face_colors(F: np.ndarray, vertex_groups: Sequence[np.ndarray] | None = None
 def render_png(panels: list, size: tuple[int, int] = (800, 600),
                view: str | Sequence[str] = "iso", colorbar: Any = None,
                legend: Any = None, axes: Any = None, note: str | None = None,
-               titles: Sequence[str] | None = None) -> bytes:
+               titles: Sequence[str] | None = None,
+               framed: np.ndarray | None = None) -> bytes:
     """PNG bytes of one or more panels side by side, for one or more views.
 
     Parameters
@@ -121,6 +122,8 @@ def render_png(panels: list, size: tuple[int, int] = (800, 600),
     note : str, optional, a line of text at the bottom (e.g. the mesh's extent)
     titles : list of str, optional, one per panel ("rest", "deformed"); with several views
         each column's label also names its view
+    framed : (p, 3) float array, optional, points the view's frame also holds (the frames of
+        an animation framed alike: every frame's extent)
     """
     import matplotlib
     matplotlib.use("Agg")
@@ -149,6 +152,10 @@ def render_png(panels: list, size: tuple[int, int] = (800, 600),
             if label:
                 fig.text((col + 0.5) * width / columns, 0.965, label, ha="center", va="top",
                          fontsize=9, color="0.2")
+        if framed is not None:
+            _, up, right = camera(name)
+            x, y = framed @ right, framed @ up
+            boxes.append((x.min(), x.max(), y.min(), y.max()))
         _frame(axes, boxes)
         if triad is not None:
             _triad(fig, v * len(panels) * width / columns, name, triad)

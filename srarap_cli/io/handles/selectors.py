@@ -102,5 +102,19 @@ def select(ctx: Context, spec: dict, V: np.ndarray, base: str) -> np.ndarray:
     picked = [_SELECTORS[k](ctx, spec[k], V, base) for k in keys]
     ids = np.unique(np.concatenate(picked))
     if ids.size == 0:
-        raise ctx.error(f"selects no vertex ({', '.join(keys)})")
+        shapes = [_shown(k, one) for k in ("box", "sphere") if k in spec
+                  for one in (spec[k] if isinstance(spec[k], list) else [spec[k]])]
+        lo, hi = V.min(axis=0), V.max(axis=0)
+        extent = ", ".join(f"{a} {lo[i]:.4g}..{hi[i]:.4g}" for i, a in enumerate("xyz"))
+        raise ctx.error(f"selects no vertex ({'; '.join(shapes) or ', '.join(keys)}); the "
+                        f"mesh spans {extent}")
     return ids
+
+
+def _shown(kind, spec):
+    """A box or sphere as the error beside the mesh's extent shows it."""
+    def vec(v):
+        return "[" + ", ".join(f"{float(x):.4g}" for x in v) + "]"
+    if kind == "box":
+        return f"box {vec(spec['min'])}..{vec(spec['max'])}"
+    return f"sphere at {vec(spec['center'])} radius {float(spec['radius']):.4g}"

@@ -1,0 +1,73 @@
+"""``render`` of an animation's frame pattern: an animated GIF or a contact sheet, every
+frame framed alike (what holds still in the animation holds still in the picture)."""
+import os
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from helpers import ROOT
+from PIL import Image
+
+from srarap_cli.cli import main
+from srarap_cli.tasks.frames import sheet_choice
+from srarap_cli.tasks.render import PALETTE
+
+BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
+TWIST = os.path.join(ROOT, "configs", "bar-twist-animated.yaml")
+
+
+@pytest.fixture(scope="module")
+def frames(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("frames")
+    pattern = str(folder / "f_{:02d}.obj")
+    r = CliRunner().invoke(main, ["animate", BAR, TWIST, "-o", pattern, "--frames", "5",
+                                  "-q"])
+    assert r.exit_code == 0, r.stderr
+    return pattern
+
+
+def render(*args):
+    return CliRunner().invoke(main, ["render", *map(str, args)])
+
+
+def red_pixels(img):
+    rgb = np.asarray(img.convert("RGB"), dtype=float) / 255
+    return np.abs(rgb - np.array(PALETTE[0][:3])).max(axis=2) < 0.3
+
+
+def test_a_gif_holds_every_frame_framed_alike_and_is_reproducible(frames, tmp_path):
+    a, b = tmp_path / "a.gif", tmp_path / "b.gif"
+    assert render(frames, "--handles", TWIST, "-o", a, "--size", "200x300").exit_code == 0
+    assert render(frames, "--handles", TWIST, "-o", b, "--size", "200x300").exit_code == 0
+    assert a.read_bytes() == b.read_bytes()
+    gif = Image.open(a)
+    assert gif.n_frames == 5 and gif.size == (200, 300)
+    # the fixed base (red) stays on the same pixels from the first frame to the last
+    gif.seek(0)
+    first = red_pixels(gif)
+    gif.seek(4)
+    last = red_pixels(gif)
+    assert first.sum() > 50 and (first & last).sum() > 0.8 * first.sum()
+
+
+def test_a_contact_sheet_is_a_grid_of_the_frames(frames, tmp_path):
+    out = tmp_path / "s.png"
+    r = render(frames, "-o", out, "--size", "100x120")
+    assert r.exit_code == 0, r.stderr
+    assert Image.open(out).size == (3 * 100, 2 * 120)  # 5 frames: 3 columns, 2 rows
+
+
+def test_sheet_choice_keeps_first_and_last_and_spreads_the_rest():
+    assert sheet_choice(5) == [0, 1, 2, 3, 4]
+    chosen = sheet_choice(1000, 24)
+    assert len(chosen) == 24 and chosen[0] == 0 and chosen[-1] == 999
+    assert np.ptp(np.diff(chosen)) <= 1
+
+
+def test_a_pattern_without_frame_0_or_with_options_it_cannot_take_is_one_line(frames, tmp_path):
+    r = render(str(tmp_path / "none_{:02d}.obj"), "-o", tmp_path / "x.gif")
+    assert r.exit_code == 4 and "no frame 0" in r.stderr
+    r = render(frames, "--rest", BAR, "-o", tmp_path / "x.gif")
+    assert r.exit_code == 2 and "frame pattern" in r.stderr
+    r = render(frames, "-o", tmp_path / "x.jpg")
+    assert r.exit_code == 2
