@@ -3,20 +3,18 @@ image there, every figure on its page and drawn by today's srarap; and opened in
 browser (headless Chromium) without console errors or broken images."""
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from browser import find_chromium, open_pages
 from helpers import ROOT
 
 sys.path.insert(0, os.path.join(ROOT, "docs"))
 from make_figures import FIGURES  # noqa: E402
 
 pytestmark = pytest.mark.slow
-#: set by .ci/run, which installs Chromium: there a missing browser fails instead of skipping
-REQUIRE_BROWSER = os.environ.get("SRARAP_REQUIRE_BROWSER") == "1"
 
 
 @pytest.fixture(scope="module")
@@ -67,62 +65,13 @@ def test_the_figures_are_what_srarap_draws_today(tmp_path):
     assert not stale, f"regenerate with python docs/make_figures.py: {stale}"
 
 
-HARNESS = """<!doctype html><html><body><pre id="out">running</pre><script>
-const pages = %s;
-const out = [];
-function next(i) {
-  if (i == pages.length) { document.getElementById('out').textContent = 'DONE\\n' + out.join('\\n'); return; }
-  const f = document.createElement('iframe');
-  f.width = 1280; f.height = 900;
-  f.onload = () => setTimeout(() => {
-    const imgs = [...f.contentDocument.images];
-    for (const img of imgs)
-      if (!(img.complete && img.naturalWidth > 0)) out.push('BROKEN ' + pages[i] + ' ' + img.src);
-    out.push('PAGE ' + pages[i] + ' ' + imgs.length);
-    f.remove(); next(i + 1);
-  }, 300);
-  f.src = pages[i];
-  document.body.appendChild(f);
-}
-next(0);
-</script></body></html>"""
-
-
 def test_a_browser_opens_every_page_without_errors_or_broken_images(site, tmp_path):
-    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
-    if chromium is None:
-        assert not REQUIRE_BROWSER, "SRARAP_REQUIRE_BROWSER=1 but no chromium on PATH"
-        pytest.skip("no Chromium here (Debian's package 'chromium'; .ci/run installs it)")
+    chromium = find_chromium()
     urls = [str(p.relative_to(site).parent) + "/" for p in pages(site)]
-    (site / "harness.html").write_text(HARNESS % repr(urls).replace("'", '"'))
-    server = subprocess.Popen([sys.executable, "-m", "http.server", "0", "-b", "127.0.0.1"],
-                              cwd=site, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                              text=True)
-    try:
-        line = server.stdout.readline()  # "Serving HTTP on 127.0.0.1 port N ..."
-        port = re.search(r"port (\d+)", line).group(1)
-        base = f"http://127.0.0.1:{port}/"
-        r = subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu",
-                            "--enable-logging=stderr", "--v=0", "--virtual-time-budget=60000",
-                            f"--user-data-dir={tmp_path / 'profile'}", "--dump-dom",
-                            base + "harness.html"], capture_output=True, text=True, timeout=300)
-        shot = Path(os.environ.get("SRARAP_SCREENSHOTS", tmp_path)) / "docs-home.png"
-        subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu",
-                        "--hide-scrollbars", "--window-size=1280,1500",
-                        f"--user-data-dir={tmp_path / 'profile2'}", f"--screenshot={shot}",
-                        base], capture_output=True, timeout=120)
-    finally:
-        server.terminate()
-        server.wait()
-    found = re.search(r'<pre id="out">(.*?)</pre>', r.stdout, re.DOTALL)
-    report = found.group(1) if found else ""
-    assert report.startswith("DONE"), r.stdout[-2000:] + r.stderr[-2000:]
-    assert "BROKEN" not in report, report
-    assert report.count("PAGE ") == len(urls)
-    shown = {page: int(n) for page, n in re.findall(r"PAGE (\S+) (\d+)", report)}
+    shot = Path(os.environ.get("SRARAP_SCREENSHOTS", tmp_path)) / "docs-home.png"
+    shown, errors = open_pages(chromium, site, urls, tmp_path, screenshot=(urls[0], shot))
+    assert not errors, errors
+    assert set(shown) == set(urls) and all(n >= 0 for n in shown.values())
     assert shown["./"] >= 1 and shown["guides/handle-files/"] >= 3  # home page, selectors
     assert shown["guides/workflows/"] >= 3
-    errors = [x for x in r.stderr.splitlines() if "CONSOLE" in x and
-              re.search(r"error|uncaught|failed", x, re.IGNORECASE)]
-    assert not errors, errors
     assert shot.is_file() and shot.stat().st_size > 10_000

@@ -42,17 +42,30 @@ def workflow_steps():
 
 def test_the_ci_workflow_passes_and_fails_on_drift(tmp_path):
     """The workflow's run steps in order, as GitHub runs them (bash -e), except the install
-    step: srarap is installed here already."""
+    step: srarap is installed here already. It publishes what its later steps upload."""
     steps = [s for s in workflow_steps() if s["name"] != "Install srarap"]
-    assert [s["name"] for s in steps] == ["Deform", "Compare with the goldens"]
-    for step in steps:
-        p = run(["bash", "-e", "-c", step["run"]], tmp_path)
-        assert p.returncode == 0, step["name"] + p.stderr
-    assert (tmp_path / "out" / "bar-twist-drift.json").exists()
+    assert [s["name"] for s in steps] == ["Deform and compare with the goldens"]
+    p = run(["bash", "-e", "-c", steps[0]["run"]], tmp_path)
+    assert p.returncode == 0, p.stderr
+    uploads = [s["with"] for s in yaml.safe_load(open(os.path.join(
+        EXAMPLES, "ci-regression", "mesh-regression.yml")))["jobs"]["regression"]["steps"]
+        if "with" in s and ("path" in s["with"] or "report_paths" in s["with"])]
+    for published in uploads:
+        assert (tmp_path / published.get("path", published.get("report_paths"))).is_file()
+    junit = (tmp_path / "out" / "junit.xml").read_text()
+    assert 'failures="0"' in junit and 'errors="0"' in junit
+    assert "strict: true" in (tmp_path / "meshes" / "configs" / "example-jobs.yaml").read_text()
+    # a golden that drifted: the step fails and the report shows that job first
     golden = tmp_path / "meshes" / "golden" / "bar-twist.obj"
     golden.write_text(golden.read_text().replace("\nv ", "\nv 0.01 0 0 #", 1))
-    p = run(["bash", "-e", "-c", steps[-1]["run"]], tmp_path)
-    assert p.returncode == 7 and "BEYOND" in p.stderr
+    p = run(["bash", "-e", "-c", "srarap batch meshes/configs/example-jobs.yaml -o out "
+             "--report out/report.html --junit out/junit.xml"], tmp_path)
+    assert p.returncode == 8 and "regressed" in p.stderr
+    html = (tmp_path / "out" / "report.html").read_text()
+    first = html.index('<section class="job"')
+    assert html[first:].startswith('<section class="job" id="bar-twist">')
+    assert "distance to the golden mesh" in html[first:html.index("</section>", first)]
+    assert '<failure type="regressed"' in (tmp_path / "out" / "junit.xml").read_text()
 
 
 def test_the_api_script_deforms_a_trimesh_mesh(tmp_path):

@@ -18,7 +18,8 @@ from ..tasks.batch import (
     load_manifest,
     run_batch,
 )
-from .common import guarded
+from ..tasks.report import junit_xml, report_html
+from .common import check_output_path, guarded
 
 #: a Dask scheduler address: protocol://host:port, or host:port
 SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
@@ -37,10 +38,14 @@ SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
               help="Folder for the jobs' outputs and summary.csv / summary.json.")
 @click.option("--keep-unconverged", is_flag=True,
               help="Write the mesh of a job that did not converge (exit code still 3).")
+@click.option("--report", help="Also write an HTML report (one self-contained file: each job's "
+              "numbers, a picture of its shape, its difference to the golden mesh and its "
+              "energy curve, drawn by the workers; failures and regressions first).")
+@click.option("--junit", help="Also write JUnit XML (one test case per job) for CI systems.")
 @click.option("-q", "--quiet", is_flag=True, help="No summary table.")
 @guarded
 def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unconverged: bool,
-          quiet: bool) -> None:
+          report: str | None, junit: str | None, quiet: bool) -> None:
     """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
 
     Exit code 0 when every job is ok or up to date, 8 when any job failed or regressed
@@ -51,6 +56,10 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     if scheduler is not None and scheduler != "local" and not SCHEDULER.fullmatch(scheduler):
         raise click.BadParameter(f"{scheduler!r} is neither 'local' nor a scheduler address "
                                  "such as tcp://host:8786", param_hint="--scheduler")
+    if report is not None:
+        check_output_path(report, (".html", ".htm"), "--report")
+    if junit is not None:
+        check_output_path(junit, (".xml",), "--junit")
     jobs = load_manifest(manifest)
     check_outputs(jobs, out, manifest)
     try:
@@ -58,11 +67,19 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     except OSError as exc:
         raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
     try:
-        rows, stopped = run_batch(jobs, out, workers, scheduler, keep_unconverged), None
+        rows, stopped = run_batch(jobs, out, workers, scheduler, keep_unconverged,
+                                  pictures=report is not None), None
     except BatchInterrupted as exc:  # the workers are stopped: say what finished
         rows, stopped = exc.rows, exc.signal
-    commit_files([(os.path.join(out, "summary.csv"), _csv(rows).encode()),
-                  (os.path.join(out, "summary.json"), (json.dumps(rows, indent=2) + "\n").encode())])
+    pictures = {r["job"]: r.pop("pictures", {}) for r in rows}
+    files = [(os.path.join(out, "summary.csv"), _csv(rows).encode()),
+             (os.path.join(out, "summary.json"), (json.dumps(rows, indent=2) + "\n").encode())]
+    title = os.path.splitext(os.path.basename(manifest))[0]
+    if report is not None:
+        files.append((report, report_html(rows, pictures, f"srarap batch: {title}").encode()))
+    if junit is not None:
+        files.append((junit, junit_xml(rows, title).encode()))
+    commit_files(files)
     counts = {s: sum(r["status"] == s for r in rows) for s in
               ("ok", "up-to-date", "not-converged", "regressed", "failed", "interrupted")}
     if not quiet or stopped is not None:

@@ -32,14 +32,17 @@ from ..io.handles import load_handles, referenced_files
 from ..io.input_files import read_input_bytes
 from ..io.mesh import format_mesh, read_mesh
 from ..io.mesh.formats import extensions
+from ..runtime import exit_codes
 from ..runtime.commit import commit_files
-from ..runtime.errors import InputError, NumericalError, excerpt
+from ..runtime.errors import InputError, NumericalError, SingularSystemError, excerpt
 from ..runtime.paths import refuse_overwriting_inputs
 from ..runtime.signals import Terminated
 from ..solver.settings import parse_mapping, resolve
 from ..solver.stop import StopReason
-from .compare import compare_meshes
+from .compare import beyond, compare_meshes
+from .job_pictures import difference_picture, energy_picture, shape_picture
 from .pipeline import deform_mesh
+from .report import EXIT_CODES, encode_png
 
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
 #: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason` (empty for a job that
@@ -49,7 +52,7 @@ Job = dict[str, Any]
 #: a job's summary row (keys SUMMARY_FIELDS)
 Row = dict[str, Any]
 SUMMARY_FIELDS = ("job", "status", "stop", "iterations", "energy", "seconds", "compare_max",
-                  "message")
+                  "message", "compare_mean", "tol", "exit_code")
 
 
 def load_manifest(path: str) -> list[Job]:
@@ -143,15 +146,19 @@ def fingerprint(job: Job) -> str:
     return h.hexdigest()
 
 
-def run_job(job: Job, out_dir: str,
-            keep_unconverged: bool = False) -> Row:
-    """Run one job; never raises. Returns its summary row (dict with SUMMARY_FIELDS).
+def run_job(job: Job, out_dir: str, keep_unconverged: bool = False,
+            pictures: bool = False) -> Row:
+    """Run one job; never raises. Returns its summary row (dict with SUMMARY_FIELDS; with
+    ``pictures``, also ``pictures``: the report's pictures of the job, see
+    :func:`job_pictures`).
 
     A job that does not converge writes its sidecar (the status, so a rerun reports it without
     solving again) but not its mesh, unless ``keep_unconverged``: as ``srarap deform``."""
     start = time.perf_counter()
     row = {"job": job["name"], "status": "failed", "stop": "", "iterations": None,
-           "energy": None, "seconds": None, "compare_max": None, "message": ""}
+           "energy": None, "seconds": None, "compare_max": None, "message": "",
+           "compare_mean": None, "tol": None, "exit_code": None}
+    seen: dict[str, Any] = {}  # what the pictures are drawn from
     out = os.path.join(out_dir, job["output"])
     sidecar = out + ".srarap.json"
     try:
@@ -169,6 +176,7 @@ def run_job(job: Job, out_dir: str,
             constraints = load_handles(job["handles"], mesh.vertices)
             opts = resolve(constraints.solver, job["settings"])
             deformed, result, _ = deform_mesh(mesh, constraints, opts, name=job["mesh"])
+            seen.update(mesh=mesh, deformed=deformed, constraints=constraints, log=result.log)
             data, _ = format_mesh(deformed, os.path.splitext(out)[1].lower())
             status = "ok" if result.complete else "not-converged"
             stop = result.stop_reason.value
@@ -183,23 +191,78 @@ def run_job(job: Job, out_dir: str,
             if not keep:
                 row["message"] = "mesh not written (--keep-unconverged writes it)"
         if job["expect"] is not None and os.path.exists(out) and row["status"] != "not-converged":
-            _check_golden(row, job["expect"], out)
+            seen["golden"] = _check_golden(row, job["expect"], out)
     except Exception as exc:  # noqa: BLE001 -- a failing job is reported, never fatal
         row.update(status="failed", message=str(exc).splitlines()[0] if str(exc) else
-                   type(exc).__name__)
+                   type(exc).__name__, exit_code=_failure_code(exc))
         if isinstance(exc, NumericalError):
             row["stop"] = StopReason.NON_FINITE.value
+    if row["exit_code"] is None:
+        row["exit_code"] = EXIT_CODES.get(row["status"])
     row["seconds"] = time.perf_counter() - start
+    if pictures:  # after the seconds: the solve's, not the drawing's
+        row["pictures"] = job_pictures(job, out, seen)
     return row
 
 
+def _failure_code(exc):
+    """The exit code ``srarap deform`` gives for the failure ``exc``."""
+    if isinstance(exc, InputError):
+        return exit_codes.INVALID_INPUT
+    if isinstance(exc, (NumericalError, SingularSystemError)):
+        return exit_codes.NUMERICAL_FAILURE
+    if isinstance(exc, OSError):
+        return exit_codes.OUTPUT_ERROR
+    return 1
+
+
+def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
+    """The report's pictures of a job (base64 PNG by name: ``shape``, ``difference``,
+    ``energy``), drawn from what the job solved or, for one up to date, from its files;
+    those that cannot be drawn are left out (a failed job's, a missing golden's)."""
+    out_pictures: dict[str, str] = {}
+    try:
+        mesh = seen["mesh"] if "mesh" in seen else read_mesh(job["mesh"])
+        deformed = seen.get("deformed")
+        if deformed is None and os.path.exists(out):
+            deformed = read_mesh(out)
+        if deformed is None or len(deformed.vertices) != len(mesh.vertices):
+            return out_pictures
+        constraints = (seen["constraints"] if "constraints" in seen
+                       else load_handles(job["handles"], mesh.vertices, any_rate=True))
+        out_pictures["shape"] = encode_png(shape_picture(mesh, deformed, constraints))
+        golden = seen.get("golden")
+        if golden is not None:
+            figures, expect = golden
+            scale = figures["diagonal"] if expect["relative"] and figures["diagonal"] > 0 \
+                else 1.0
+            d = figures["distances"]
+            d = d if figures["mode"] == "per-vertex" else d[-len(deformed.vertices):]
+            out_pictures["difference"] = encode_png(
+                difference_picture(mesh, deformed, d, expect["tol"], scale))
+        if seen.get("log"):
+            out_pictures["energy"] = encode_png(energy_picture(seen["log"]))
+    except Exception:  # noqa: BLE001 -- a picture that cannot be drawn is left out
+        pass
+    return out_pictures
+
+
 def _check_golden(row, expect, out):
+    """Compare the job's output with its golden mesh into ``row``; returns the figures and
+    ``expect`` (for the report's difference picture)."""
     figures = compare_meshes(read_mesh(expect["golden"]), read_mesh(out))
     scale = figures["diagonal"] if expect["relative"] and figures["diagonal"] > 0 else 1.0
-    row["compare_max"] = figures["max"] / scale
+    row.update(compare_max=figures["max"] / scale, compare_mean=figures["mean"] / scale,
+               tol=expect["tol"])
     if row["compare_max"] > expect["tol"]:
         row["status"] = "regressed"
-        row["message"] = f"max distance {row['compare_max']:.3g} > tol {expect['tol']:g}"
+        far = figures["where"]
+        at = "" if far is None else (f" at vertex {far['vertex']} of the "
+                                     f"{'golden' if far['mesh'] == 'a' else 'output'} mesh")
+        row["message"] = (f"max distance {row['compare_max']:.3g} > tol {expect['tol']:g}"
+                          f"{at}; {100 * beyond(figures, expect['tol'], expect['relative']):.3g}"
+                          "% of the vertices beyond tol")
+    return figures, expect
 
 
 def _recorded(sidecar):
@@ -220,15 +283,16 @@ def _recorded_row(sidecar):
 
 
 def run_batch(jobs: list[Job],
-              out_dir: str, workers: int = 1, scheduler: str | None = None, keep_unconverged: bool = False
-              ) -> list[Row]:
+              out_dir: str, workers: int = 1, scheduler: str | None = None, keep_unconverged: bool = False,
+              pictures: bool = False) -> list[Row]:
     """Run jobs: on a Dask cluster at ``scheduler``, else in ``workers`` local processes
     (in this process when 1). Rows come back in manifest order. ``keep_unconverged``: see
     :func:`run_job`.
 
     The Dask workers must see the same files as this process (a shared file system).
     """
-    run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged)
+    run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged,
+                            pictures=pictures)
     if scheduler is not None:
         return _run_on_dask(jobs, run, scheduler, workers)
     if workers <= 1:
@@ -257,7 +321,8 @@ def interrupted_row(job: Job) -> Row:
     """The summary row of a job a signal stopped before it finished."""
     return {"job": job["name"], "status": "interrupted", "stop": "", "iterations": None,
             "energy": None, "seconds": None, "compare_max": None,
-            "message": "not finished: the batch was interrupted"}
+            "message": "not finished: the batch was interrupted", "compare_mean": None,
+            "tol": None, "exit_code": EXIT_CODES["interrupted"]}
 
 
 #: seconds the workers get to stop after SIGTERM before they are killed

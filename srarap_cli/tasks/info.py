@@ -171,6 +171,8 @@ def _up_guess(V, F):
     otherwise the axis whose lowest slab carries more downward-facing area (a base, feet, a
     bottom); y on a tie, as most OBJ and PLY files are y-up. A guess, and said to be one: a
     lying cylinder fools it."""
+    if not len(V) or not len(F):
+        return "+y"
     lo, hi = V.min(axis=0), V.max(axis=0)
     extent = hi - lo
     for k in (1, 2):

@@ -133,7 +133,8 @@ def render_png(panels: list, size: tuple[int, int] = (800, 600),
 
     dpi = 100
     fig = plt.figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
-    width = 0.86 if colorbar else 1.0
+    # the colour bar and its labels take about 90 pixels, whatever the picture's width
+    width = 1.0 - min(0.4, 90 / size[0]) if colorbar else 1.0
     triad = axes
     views = [view] if isinstance(view, str) else list(view)
     columns = len(views) * len(panels)
@@ -160,10 +161,13 @@ def render_png(panels: list, size: tuple[int, int] = (800, 600),
         if triad is not None:
             _triad(fig, v * len(panels) * width / columns, name, triad)
     if colorbar:
-        cax = fig.add_axes((0.895, 0.12, 0.022, 0.76))
+        cax = fig.add_axes((width + 0.1 * (1 - width), 0.12, 0.022 * 800 / size[0], 0.76))
         bar = fig.colorbar(ScalarMappable(Normalize(0, colorbar[1]), "viridis"), cax=cax)
         bar.set_label(colorbar[0], fontsize=7, labelpad=2)
         bar.ax.tick_params(labelsize=7)
+        from matplotlib.ticker import FuncFormatter
+        bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
+        bar.ax.yaxis.get_offset_text().set_visible(False)
     if legend:
         from matplotlib.patches import Patch
         fig.legend(handles=[Patch(color=PALETTE[k % len(PALETTE)], label=text)

@@ -104,6 +104,8 @@ def select(ctx: Context, spec: dict, V: np.ndarray, base: str) -> np.ndarray:
     if ids.size == 0:
         shapes = [_shown(k, one) for k in ("box", "sphere") if k in spec
                   for one in (spec[k] if isinstance(spec[k], list) else [spec[k]])]
+        if not len(V):
+            raise ctx.error(f"selects no vertex ({', '.join(keys)}): the mesh has none")
         lo, hi = V.min(axis=0), V.max(axis=0)
         extent = ", ".join(f"{a} {lo[i]:.4g}..{hi[i]:.4g}" for i, a in enumerate("xyz"))
         raise ctx.error(f"selects no vertex ({'; '.join(shapes) or ', '.join(keys)}); the "
