@@ -370,6 +370,25 @@ def _stop(pool):
         if p.is_alive():
             p.kill()
             p.join(1.0)
+    _let_exit_go(pool)
+
+
+def _let_exit_go(pool):
+    """Keep the interpreter's exit from waiting on the pool's threads once its workers are
+    gone. At exit Python joins the executor's manager thread and the call queue's feeder
+    thread without a timeout; with the workers killed mid-job, under load, one of them could
+    still be waiting (a batch stopped by a signal took 39 s, once more than 60, to end after
+    its summary was written). Both are given the grace period, then left behind."""
+    from concurrent.futures import process
+
+    queue = getattr(pool, "_call_queue", None)
+    if queue is not None:
+        queue.cancel_join_thread()
+    thread = getattr(pool, "_executor_manager_thread", None)
+    if thread is not None:
+        thread.join(STOP_GRACE)
+        if thread.is_alive():
+            getattr(process, "_threads_wakeups", {}).pop(thread, None)
 
 
 #: what srarap's own Dask workers get instead of Dask's defaults: one BLAS thread, and glibc's
