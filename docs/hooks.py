@@ -1,4 +1,6 @@
-"""MkDocs hooks: the command-line reference's Default column.
+"""MkDocs hooks: what the generated references need before a reader sees them.
+
+The command-line reference's Default column:
 
 mkdocs-click prints Click's ``Sentinel.UNSET`` for an option without a default. Every srarap
 option of that kind either says its default in its help (``[default: 0.14]``: the solver
@@ -25,10 +27,8 @@ def _row(match):
             f"<td>{match['help']}</td>\n<td>{default}</td>\n</tr>")
 
 
-def on_page_content(html, page, config, files):
-    if "Sentinel." not in html:
-        return html
-    return ROW.sub(_row, html)
+def _cli(html):
+    return ROW.sub(_row, html) if "Sentinel." in html else html
 
 
 # The API reference: the docstrings are numpydoc written for readers of the source, where
@@ -66,11 +66,7 @@ def _api(html):
     return DOUBLED.sub(r"\1", html)
 
 
-_on_cli = on_page_content
-
-
-def on_page_content(html, page, config, files):  # noqa: F811 (both pages' fixes)
-    html = _on_cli(html, page, config, files)
-    if page.file.src_uri == "reference/api.md":
-        html = _api(html)
-    return html
+def on_page_content(html, page, config, files):
+    """MkDocs' hook: the command-line and API references' fixes."""
+    html = _cli(html)
+    return _api(html) if page.file.src_uri == "reference/api.md" else html
