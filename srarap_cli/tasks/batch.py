@@ -333,7 +333,8 @@ def _run_in_processes(jobs, run, workers):
     """Jobs in ``workers`` processes, rows in manifest order. A signal to this process
     stops the workers (SIGTERM, then SIGKILL after :data:`STOP_GRACE` seconds), keeps the
     rows of the jobs that finished and raises :class:`BatchInterrupted`."""
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals,
+                               initargs=(os.getpid(),))
     futures = []
     try:
         futures = [pool.submit(run, job) for job in jobs]
@@ -348,14 +349,33 @@ def _run_in_processes(jobs, run, workers):
     return rows
 
 
-def _worker_signals():
+def _worker_signals(batch_pid=None):
     """A worker leaves SIGINT to the batch (a terminal's Ctrl-C reaches the whole group: the
     batch stops the workers and reports) and leaves at once on SIGTERM, from the batch: an
     exception raised there could land in any destructor and print a traceback. Its commits
     hold signals back while they rename, and the temporary files it staged are swept by
-    the next write into their folder."""
+    the next write into their folder. It never outlives the batch (``batch_pid``): see
+    :func:`_die_with`."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, lambda signum, frame: os._exit(143))
+    if batch_pid is not None:
+        _die_with(batch_pid)
+
+
+def _die_with(batch_pid):
+    """Have the kernel kill this worker when the batch process ends (Linux), and leave now
+    if it already has. A worker forked just as a signal stopped the batch, before the batch
+    knew of it, escaped the batch's SIGTERM/SIGKILL: it then waited for a job forever, and
+    held the batch's standard error open (a CI test waiting for its end timed out)."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: the batch's own stop has to do
+        pass
+    if os.getppid() != batch_pid:
+        os._exit(143)
 
 
 def _stop(pool):
