@@ -205,3 +205,9 @@ def test_a_report_of_100_jobs_stays_small_and_opens_in_a_browser(run, tmp_path):
     assert not errors, errors
     assert len(pictures) >= 2 and shown == {"report.html": 100 * len(pictures)}  # all loaded
     assert shot.is_file() and shot.stat().st_size > 20_000
+
+
+def test_a_picture_that_cannot_be_drawn_is_said_in_the_report_not_hidden():
+    row = {"job": "j", "status": "ok", "seconds": 1.0, "message": ""}
+    page = report_html([row], {"j": {"note": "pictures not drawn: ValueError: bad mesh"}}, "t")
+    assert "pictures not drawn: ValueError: bad mesh" in page and "<img" not in page

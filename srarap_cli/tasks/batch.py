@@ -219,7 +219,8 @@ def _failure_code(exc):
 def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
     """The report's pictures of a job (base64 PNG by name: ``shape``, ``difference``,
     ``energy``), drawn from what the job solved or, for one up to date, from its files;
-    those that cannot be drawn are left out (a failed job's, a missing golden's)."""
+    those without their data are left out (a failed job's, a missing golden's); a drawing
+    that fails leaves ``note`` instead, which the report shows."""
     out_pictures: dict[str, str] = {}
     try:
         mesh = seen["mesh"] if "mesh" in seen else read_mesh(job["mesh"])
@@ -242,8 +243,8 @@ def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
                 difference_picture(mesh, deformed, d, expect["tol"], scale))
         if seen.get("log"):
             out_pictures["energy"] = encode_png(energy_picture(seen["log"]))
-    except Exception:  # noqa: BLE001 -- a picture that cannot be drawn is left out
-        pass
+    except Exception as exc:  # noqa: BLE001 -- the report says why, the job's result stands
+        out_pictures["note"] = f"pictures not drawn: {type(exc).__name__}: {exc}"
     return out_pictures
 
 

@@ -91,8 +91,8 @@ def _job(row, pictures):
         f"<figure><img alt=\"{html.escape(caption)}\" src=\"data:image/png;base64,"
         f"{pictures[key]}\"><figcaption>{html.escape(caption)}</figcaption></figure>"
         for key, caption in PICTURES if key in pictures)
-    message = (f"<p class=\"message\">{html.escape(row['message'])}</p>"
-               if row.get("message") else "")
+    message = "".join(f"<p class=\"message\">{html.escape(text)}</p>"
+                      for text in (row.get("message"), pictures.get("note")) if text)
     return (f"<section class=\"job\" id=\"{html.escape(row['job'], quote=True)}\"><h2>"
             f"{html.escape(row['job'])} <span class=\"badge\" style=\"background:"
             f"{COLOURS.get(status, '#555')}\">{html.escape(status)}</span></h2>{message}"
