@@ -72,7 +72,7 @@ def test_one_nested_dissection_serves_the_poisson_matrix_and_the_rotor_precondit
     real = pymetis.nested_dissection
     monkeypatch.setattr(pymetis, "nested_dissection",
                         lambda *a, **k: runs.append(1) or real(*a, **k))
-    monkeypatch.setattr(linalg, "run_forked", lambda func, *args: func(*args))  # count here
+    monkeypatch.setattr(linalg, "APART_FROM", 10**12)  # METIS in this process: counted here
     monkeypatch.setattr(linalg, "LARGE", 0)
     V, F = tube(length=6.0, rings=12, segments=8)
     ids = ends(V, 6.0)
@@ -149,26 +149,28 @@ def test_the_mesh_order_dissects_every_edge_even_of_zero_weight():
     assert _fill(sub, graph.fill_order(rows)) <= 1.2 * _fill(sub, linalg.fill_order(sub))
 
 
-def test_the_order_from_a_forked_child_is_the_order_computed_here(monkeypatch):
-    """METIS runs in a child where it can (it holds the GIL); where it cannot, or the child
+def test_the_order_from_another_process_is_the_order_computed_here(monkeypatch):
+    """METIS runs in a fresh interpreter for large graphs (it holds the GIL); where that
     fails or answers nonsense, the parent computes the very same order itself."""
     V, F = tube(length=6.0, rings=16, segments=10)
     A = igl.cotmatrix(V, F)
-    forked = linalg.fill_order(A)
-    assert np.array_equal(np.sort(forked), np.arange(len(V)))
+    here = linalg.fill_order(A)  # small: in this process
+    assert np.array_equal(np.sort(here), np.arange(len(V)))
+    monkeypatch.setattr(linalg, "APART_FROM", 0)
+    calls = []
+    real = linalg.run_fresh
+    monkeypatch.setattr(linalg, "run_fresh", lambda *a: calls.append(real(*a)) or calls[-1])
+    assert np.array_equal(linalg.fill_order(A), here)
+    assert calls[0] is not None  # the child answered: every vertex is linked, so its order
+    assert np.array_equal(np.frombuffer(calls[0], dtype="<i8"), here)  # is the result itself
     for answer in (None, b"", b"\x00" * 8 * len(V)):
-        monkeypatch.setattr(linalg, "run_forked", lambda func, *args, out=answer: out)
-        assert np.array_equal(linalg.fill_order(A), forked)
+        monkeypatch.setattr(linalg, "run_fresh", lambda *a, out=answer: out)
+        assert np.array_equal(linalg.fill_order(A), here)
 
 
-def test_a_failing_child_reports_failure_and_a_working_one_its_bytes():
-    from srarap_cli.runtime import forked
+def test_a_fresh_process_reports_failure_and_gives_back_what_it_wrote():
+    from srarap_cli.runtime.fresh_process import run_fresh
 
-    def boom():
-        raise RuntimeError("in the child")
-
-    assert forked.run_forked(boom) is None
-    big = bytes(range(256)) * 40_000  # more than a pipe's buffer
-    assert forked.run_forked(lambda: big) in (big, None)
-    if forked._FORK_OK:
-        assert forked.run_forked(lambda: big) == big
+    assert run_fresh("raise RuntimeError('in the child')", b"") is None
+    big = bytes(range(256)) * 40_000  # more than a pipe's buffer, both ways
+    assert run_fresh("sys.stdout.buffer.write(payload[::-1])", big) == big[::-1]

@@ -181,3 +181,28 @@ def test_a_file_name_with_a_newline_is_one_line(case):
                         "-o", "o.obj"], cwd=case, capture_output=True, text=True, timeout=60)
     assert p.returncode == 4 and p.stderr.count("\n") == 1 and "no\\nsuch.obj" in p.stderr
 
+
+
+@pytest.mark.parametrize("args", [["info", "m.obj"], ["info", "missing.obj"],
+                                  ["deform", "m.obj", "h.yaml", "-o", "n.obj"],
+                                  ["deform", "--no-such-option"]])
+def test_a_command_run_in_process_gives_the_host_its_signal_handlers_back(case, monkeypatch,
+                                                                          args):
+    """A host (a test runner, a notebook, a service) keeps its own SIGINT/SIGTERM handling
+    after running a command in-process, whatever the command's end: left routed to
+    srarap's exceptions, a SIGTERM meant for the host raised an exception wherever it was."""
+    from srarap_cli.cli import main
+
+    def host(signum, frame):
+        pass
+
+    monkeypatch.chdir(case)
+    saved = {signum: signal.signal(signum, host) for signum in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        with pytest.raises(SystemExit):
+            main(args)
+        assert signal.getsignal(signal.SIGINT) is host
+        assert signal.getsignal(signal.SIGTERM) is host
+    finally:
+        for signum, handler in saved.items():
+            signal.signal(signum, handler)

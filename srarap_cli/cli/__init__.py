@@ -9,7 +9,7 @@ codes, summaries); only ``srarap_cli.entry`` imports it.
 import importlib
 import sys
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, NoReturn
 
 import click
 from click.core import Command, Context
@@ -66,8 +66,12 @@ class LazyGroup(click.Group):
         failure (Click prints a usage block first), exit code 2 for bad usage."""
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, False, **extra)
-        signals.install()
         pin_process()
+        with signals.routed():
+            self._main_routed(args, prog_name, complete_var, **extra)
+
+    def _main_routed(self, args: Sequence[str] | None, prog_name: str | None,
+                     complete_var: str | None, **extra: Any) -> NoReturn:
         try:
             code = super().main(args, prog_name, complete_var, False, **extra)
         except signals.Terminated:  # before a command's own handling took over

@@ -56,11 +56,10 @@ def guarded(func: Callable[..., None]) -> Callable[..., None]:
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
         debug = click.get_current_context().find_root().params.get("debug", False)
-        signals.install()
         try:
             # non-finite results are detected and reported as numerical failures; numpy's own
             # floating-point warnings would only add multi-line noise to stderr
-            with np.errstate(all="ignore"):
+            with signals.routed(), np.errstate(all="ignore"):
                 return func(*args, **kwargs)
         except (click.exceptions.Exit, click.ClickException, SystemExit):
             raise

@@ -15,7 +15,7 @@ import signal
 import sys
 import threading
 from collections.abc import Callable, Iterator
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from . import streams
 
@@ -44,14 +44,31 @@ def own() -> None:
     """Take the signals for the ``srarap`` process (the console entry calls this first)."""
     global OWNED
     OWNED = True
-    install()
+    _route()
 
 
-def install() -> None:
-    """Route SIGINT and SIGTERM to exceptions (main thread only: signals go there)."""
-    if threading.current_thread() is threading.main_thread():
-        for signum in SIGNALS:
-            signal.signal(signum, _on_signal)
+def _route() -> dict[int, Any]:
+    """Route SIGINT and SIGTERM to exceptions (main thread only: signals go there); returns
+    the handlers they replaced."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    return {signum: signal.signal(signum, _on_signal) for signum in SIGNALS}
+
+
+@contextlib.contextmanager
+def routed() -> Iterator[None]:
+    """SIGINT and SIGTERM routed to exceptions inside the block. In a process that hosts
+    srarap (a test runner, a notebook, a service calling the command in-process), the host's
+    handlers come back after it: left in place, a SIGTERM meant to end the host later raised
+    :class:`Terminated` wherever the host happened to be (a pytest-xdist worker printed a
+    traceback and stayed alive)."""
+    before = _route()
+    try:
+        yield
+    finally:
+        if not OWNED:
+            for signum, handler in before.items():
+                signal.signal(signum, handler if handler is not None else signal.SIG_DFL)
 
 
 @contextlib.contextmanager

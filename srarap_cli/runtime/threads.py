@@ -10,10 +10,12 @@ running jobs side by side (``batch --workers``), and from one overlap of indepen
 (:func:`background`: a multiresolution solve's full-resolution setup beside its simplification,
 which do not share data, so the results stay the same bit for bit).
 """
+import contextlib
 import functools
 import os
+import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar, cast
 
 T = TypeVar("T")
@@ -97,3 +99,75 @@ def background(func: Callable[[], T]) -> Callable[[], T]:
         return out["value"]
 
     return wait
+
+
+@contextlib.contextmanager
+def worker_processes(preload: Sequence[str] = (), threads_ahead: bool = False) -> Iterator[Any]:
+    """The multiprocessing context for srarap's worker processes, inside the block.
+
+    ``fork`` (a worker starts with everything imported) where this process runs a single
+    thread (Linux) and will while it starts them (not ``threads_ahead``: a Dask cluster's
+    own threads start first); else ``forkserver``: a fresh, single-threaded server started
+    here, which imports the modules ``preload`` names once, so that each worker forked from
+    it starts with them, and which ends with the block (a server left from an earlier
+    block, with another environment, is not reused); the platform's default where there is
+    no fork server (Windows). A fork beside other threads (a host's: a test runner's, a
+    notebook's; a cluster's) copies locks they may hold into a child that then waits on them
+    forever.
+
+    Examples
+    --------
+    >>> with worker_processes() as context:
+    ...     context.get_start_method() in ("fork", "forkserver", "spawn")
+    True
+    """
+    import multiprocessing
+
+    if sys.platform.startswith("linux") and not threads_ahead and _threads() == 1:
+        yield multiprocessing.get_context("fork")
+    elif "forkserver" not in multiprocessing.get_all_start_methods():
+        yield multiprocessing.get_context()
+    else:
+        _stop_fork_server()
+        try:
+            yield _start_fork_server(preload)
+        finally:
+            _stop_fork_server()
+
+
+def _start_fork_server(preload):
+    """Start the server with this ``preload`` and one BLAS thread, which every process it
+    forks keeps (started now: a library that sets its own preload later, as Dask does,
+    would otherwise replace it)."""
+    import multiprocessing
+    from multiprocessing import forkserver
+
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(list(preload))
+    before = {name: os.environ.get(name) for name in _VARIABLES}
+    os.environ.update(dict.fromkeys(_VARIABLES, "1"))
+    try:
+        forkserver.ensure_running()
+    finally:
+        for name, value in before.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
+    return context
+
+
+def _stop_fork_server():
+    from multiprocessing import forkserver
+
+    stop = getattr(getattr(forkserver, "_forkserver", None), "_stop", None)
+    if stop is not None:  # CPython's; elsewhere a server ends with this process
+        stop()
+
+
+def _threads() -> int:
+    """How many threads this process runs (all of them, not only Python's)."""
+    try:
+        return len(os.listdir("/proc/self/task"))
+    except OSError:
+        return threading.active_count() + 1  # unknown: never taken for a single thread

@@ -8,8 +8,8 @@ import scipy.sparse.linalg as spla
 from scipy.sparse import csr_matrix
 
 from ..runtime.errors import SingularSystemError
-from ..runtime.forked import run_forked
 from ..runtime.fpu import subnormals_flushed
+from ..runtime.fresh_process import run_fresh
 from ..runtime.limits import is_out_of_memory
 from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
@@ -152,9 +152,9 @@ def fill_order(A: csr_matrix) -> np.ndarray:
     """METIS nested dissection order of the graph of a symmetric sparse matrix's stored
     off-diagonal entries (explicit zeros count); vertices without any come first.
 
-    METIS runs in a forked child where the platform allows (:mod:`..runtime.forked`): it
-    keeps the GIL for its whole run, which stalled the simplification running beside it; the
-    order is the same either way.
+    From :data:`APART_FROM` linked vertices on, METIS runs in a fresh interpreter
+    (:mod:`..runtime.fresh_process`): it keeps the GIL for its whole run, which stalled the
+    simplification running beside it. The order is the same either way.
 
     Parameters
     ----------
@@ -174,20 +174,37 @@ def fill_order(A: csr_matrix) -> np.ndarray:
     ids = np.flatnonzero(linked)
     sub = graph[ids][:, ids]
     sub.sort_indices()
-    adjacency = pymetis.CSRAdjacency(sub.indptr, sub.indices)
-    # the child gets the function itself: no import statement runs after the fork
-    found = run_forked(_dissection_bytes, pymetis.nested_dissection, adjacency)
+    found = run_fresh(_DISSECTION, _adjacency_bytes(sub)) if ids.size >= APART_FROM else None
     order = (np.frombuffer(found, dtype="<i8") if found is not None and _is_permutation(found, ids.size)
-             else _dissection(pymetis.nested_dissection, adjacency))
+             else _dissection(pymetis, sub.indptr, sub.indices))
     return np.concatenate([np.flatnonzero(~linked), ids[order]])
 
 
-def _dissection(nested_dissection, adjacency):
-    return np.asarray(nested_dissection(adjacency)[0], dtype=np.int64)
+#: linked vertices from which METIS runs in another process: starting one (an interpreter,
+#: numpy and pymetis) takes about 0.2 s, what METIS takes for about 35k vertices
+APART_FROM = 100_000
 
 
-def _dissection_bytes(nested_dissection, adjacency):
-    return _dissection(nested_dissection, adjacency).astype("<i8").tobytes()
+def _dissection(pymetis, indptr, indices):
+    adjacency = pymetis.CSRAdjacency(indptr, indices)
+    return np.asarray(pymetis.nested_dissection(adjacency)[0], dtype=np.int64)
+
+
+def _adjacency_bytes(sub):
+    """The graph for :data:`_DISSECTION`: n, then indptr (n + 1) and indices, int64."""
+    n = np.array([sub.shape[0]], dtype="<i8")
+    return b"".join(np.ascontiguousarray(a, dtype="<i8").tobytes()
+                    for a in (n, sub.indptr, sub.indices))
+
+
+#: the child's side of :func:`fill_order` (source for :func:`run_fresh`)
+_DISSECTION = """import numpy as np, pymetis
+n = int(np.frombuffer(payload, "<i8", 1)[0])
+indptr = np.frombuffer(payload, "<i8", n + 1, 8)
+indices = np.frombuffer(payload, "<i8", offset=8 * (n + 2))
+order = pymetis.nested_dissection(pymetis.CSRAdjacency(indptr, indices))[0]
+sys.stdout.buffer.write(np.asarray(order, dtype="<i8").tobytes())
+"""
 
 
 def _is_permutation(found, n):

@@ -37,6 +37,7 @@ from ..runtime.commit import commit_files
 from ..runtime.errors import InputError, NumericalError, SingularSystemError, excerpt
 from ..runtime.paths import refuse_overwriting_inputs
 from ..runtime.signals import Terminated
+from ..runtime.threads import worker_processes
 from ..solver.settings import parse_mapping, resolve
 from ..solver.stop import StopReason
 from .compare import beyond, compare_meshes
@@ -326,6 +327,9 @@ def interrupted_row(job: Job) -> Row:
             "tol": None, "exit_code": EXIT_CODES["interrupted"]}
 
 
+#: what the server that forks worker processes imports first: the jobs' code and the workers'
+#: signal dispositions
+WORKER_START = "srarap_cli.tasks.worker_start"
 #: seconds the workers get to stop after SIGTERM before they are killed
 STOP_GRACE = 2.0
 
@@ -334,20 +338,23 @@ def _run_in_processes(jobs, run, workers):
     """Jobs in ``workers`` processes, rows in manifest order. A signal to this process
     stops the workers (SIGTERM, then SIGKILL after :data:`STOP_GRACE` seconds), keeps the
     rows of the jobs that finished and raises :class:`BatchInterrupted`."""
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals,
-                               initargs=(os.getpid(),))
-    futures = []
-    try:
-        futures = [pool.submit(run, job) for job in jobs]
-        rows = [f.result() for f in futures]
-    except (KeyboardInterrupt, Terminated) as exc:
-        _stop(pool)
-        finished = {k: f.result() for k, f in enumerate(futures)
-                    if f.done() and not f.cancelled() and f.exception() is None}
-        raise BatchInterrupted([finished.get(k) or interrupted_row(job)
-                                for k, job in enumerate(jobs)], exc) from None
-    pool.shutdown()
-    return rows
+    with worker_processes([WORKER_START]) as context:
+        forked = context.get_start_method() == "fork"
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                   initializer=_worker_signals,
+                                   initargs=(os.getpid() if forked else None,))
+        futures = []
+        try:
+            futures = [pool.submit(run, job) for job in jobs]
+            rows = [f.result() for f in futures]
+        except (KeyboardInterrupt, Terminated) as exc:
+            _stop(pool)
+            finished = {k: f.result() for k, f in enumerate(futures)
+                        if f.done() and not f.cancelled() and f.exception() is None}
+            raise BatchInterrupted([finished.get(k) or interrupted_row(job)
+                                    for k, job in enumerate(jobs)], exc) from None
+        pool.shutdown()
+        return rows
 
 
 def _worker_signals(batch_pid=None):
@@ -355,19 +362,19 @@ def _worker_signals(batch_pid=None):
     batch stops the workers and reports) and leaves at once on SIGTERM, from the batch: an
     exception raised there could land in any destructor and print a traceback. Its commits
     hold signals back while they rename, and the temporary files it staged are swept by
-    the next write into their folder. It never outlives the batch (``batch_pid``): see
-    :func:`_die_with`."""
+    the next write into their folder. It never outlives its parent (the batch, or the fork
+    server that ends with it): see :func:`_die_with`."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, lambda signum, frame: os._exit(143))
-    if batch_pid is not None:
-        _die_with(batch_pid)
+    _die_with(batch_pid)
 
 
 def _die_with(batch_pid):
-    """Have the kernel kill this worker when the batch process ends (Linux), and leave now
-    if it already has. A worker forked just as a signal stopped the batch, before the batch
-    knew of it, escaped the batch's SIGTERM/SIGKILL: it then waited for a job forever, and
-    held the batch's standard error open (a CI test waiting for its end timed out)."""
+    """Have the kernel kill this worker when its parent ends (Linux), and leave now if the
+    batch (``batch_pid``, the parent of a forked worker) already has. A worker forked just
+    as a signal stopped the batch, before the batch knew of it, escaped the batch's
+    SIGTERM/SIGKILL: it then waited for a job forever, and held the batch's standard error
+    open (a CI test waiting for its end timed out)."""
     try:
         import ctypes
 
@@ -375,7 +382,7 @@ def _die_with(batch_pid):
         libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
     except (OSError, AttributeError):  # not Linux: the batch's own stop has to do
         pass
-    if os.getppid() != batch_pid:
+    if batch_pid is not None and os.getppid() != batch_pid:
         os._exit(143)
 
 
@@ -416,15 +423,16 @@ def _let_exit_go(pool):
 #: dynamic malloc trimming (Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536, which turned each
 #: solve's large temporaries into mmap/munmap pairs: system time 0.23 -> 4.5 s for 20 jobs)
 WORKER_ENVIRON = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1}
-#: Dask settings for the workers srarap starts. They are forked: a spawned worker imports
-#: numpy, scipy, libigl and distributed again (about 1.5 s for two), which made 20 jobs of 5k
-#: vertices take 4.7 s against 3.2 s with --workers 2. The rest wakes the workers less often:
+#: Dask settings for the workers srarap starts. They come from a fork server that imported
+#: the jobs' code once: a spawned worker imports numpy, scipy, libigl and distributed again
+#: (about 1.5 s for two), which made 20 jobs of 5k vertices take 4.7 s against 3.2 s with
+#: --workers 2; forked from the batch itself they were quick but forked beside the cluster's
+#: threads (see :func:`..runtime.threads.process_context`). The rest wakes the workers less often:
 #: Dask's profiler samples the running task's stack every 10 ms (for a dashboard these
 #: clusters do not have), event loops tick every 20 ms, monitors poll psutil 10 times a
 #: second; on 2 cores each wake-up takes the core from a solve. With Dask's defaults a job
 #: used 5.6% more CPU time in its thread than in a --workers 2 process; with these settings, 1%.
 LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRON,
-                "distributed.worker.multiprocessing-method": "fork",
                 "distributed.worker.profile.enabled": False,
                 "distributed.admin.tick.interval": "1s",
                 "distributed.admin.system-monitor.interval": "5s",
@@ -436,24 +444,32 @@ def _run_on_dask(jobs, run, scheduler, workers):
     worker processes when ``scheduler`` is ``local``."""
     try:
         import dask
-        from distributed import Client, LocalCluster
+        from distributed import LocalCluster
     except ImportError:
         raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
     run = functools.partial(run, out_dir=os.path.abspath(run.keywords["out_dir"]))
-    cluster = None
-    if scheduler == "local":
-        # the workers are forked while the cluster starts: they keep these settings
-        with dask.config.set(LOCAL_CONFIG), _without_dasks_trim_setting(), \
-                _workers_leave_sigint_to_the_batch():
+    if scheduler != "local":
+        return _gather_at(scheduler, jobs, run)
+    # the cluster runs threads from its start: its workers come from a fork server
+    with _without_dasks_trim_setting(), \
+            worker_processes([WORKER_START, "distributed"], threads_ahead=True) as context:
+        with dask.config.set({**LOCAL_CONFIG, "distributed.worker.multiprocessing-method":
+                              context.get_start_method()}):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None)
+        try:
+            return _gather_at(cluster, jobs, run)
+        finally:
+            cluster.close()
+
+
+def _gather_at(scheduler, jobs, run):
+    from distributed import Client
+
     try:
-        return _gather(Client(cluster or scheduler, timeout=30), jobs, run)
+        return _gather(Client(scheduler, timeout=30), jobs, run)
     except (OSError, TimeoutError) as exc:
         raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
-    finally:
-        if cluster is not None:
-            cluster.close()
 
 
 @contextlib.contextmanager
@@ -470,31 +486,6 @@ def _without_dasks_trim_setting():
             os.environ["MALLOC_TRIM_THRESHOLD_"] = value
 
 
-#: set while a local cluster forks its workers (see :func:`_dask_worker_signals`)
-_FORKING_DASK_WORKERS = False
-
-
-@contextlib.contextmanager
-def _workers_leave_sigint_to_the_batch():
-    """While the cluster starts, the workers it forks leave SIGINT to the batch (a
-    terminal's Ctrl-C reaches the whole group) and die of SIGTERM (how their nanny stops
-    them): with srarap's handlers, inherited through the fork, each printed a traceback
-    from its event loop."""
-    global _FORKING_DASK_WORKERS
-    _FORKING_DASK_WORKERS = True
-    try:
-        yield
-    finally:
-        _FORKING_DASK_WORKERS = False
-
-
-def _dask_worker_signals():
-    if _FORKING_DASK_WORKERS:  # in the child, just forked: its only thread is the main one
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
-os.register_at_fork(after_in_child=_dask_worker_signals)
 
 
 def _silence_dask():
