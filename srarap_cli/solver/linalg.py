@@ -209,7 +209,7 @@ sys.stdout.buffer.write(np.asarray(order, dtype="<i8").tobytes())
 
 def _is_permutation(found, n):
     """Whether the child's bytes are a permutation of ``range(n)``."""
-    if found is None or len(found) != 8 * n:
+    if len(found) != 8 * n:
         return False
     order = np.frombuffer(found, dtype="<i8")
     return bool(n == 0 or (order.min() >= 0 and order.max() < n

@@ -426,8 +426,9 @@ WORKER_ENVIRON = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THRE
 #: Dask settings for the workers srarap starts. They come from a fork server that imported
 #: the jobs' code once: a spawned worker imports numpy, scipy, libigl and distributed again
 #: (about 1.5 s for two), which made 20 jobs of 5k vertices take 4.7 s against 3.2 s with
-#: --workers 2; forked from the batch itself they were quick but forked beside the cluster's
-#: threads (see :func:`..runtime.threads.process_context`). The rest wakes the workers less often:
+#: --workers 2; forked from the batch itself they started at once, but beside the cluster's
+#: threads (see :func:`..runtime.threads.worker_processes`). The rest wakes the workers less
+#: often:
 #: Dask's profiler samples the running task's stack every 10 ms (for a dashboard these
 #: clusters do not have), event loops tick every 20 ms, monitors poll psutil 10 times a
 #: second; on 2 cores each wake-up takes the core from a solve. With Dask's defaults a job
@@ -449,7 +450,7 @@ def _run_on_dask(jobs, run, scheduler, workers):
         raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
     run = functools.partial(run, out_dir=os.path.abspath(run.keywords["out_dir"]))
     if scheduler != "local":
-        return _gather_at(scheduler, jobs, run)
+        return _gather_at(scheduler, jobs, run, scheduler)
     # the cluster runs threads from its start: its workers come from a fork server
     with _without_dasks_trim_setting(), \
             worker_processes([WORKER_START, "distributed"], threads_ahead=True) as context:
@@ -458,16 +459,18 @@ def _run_on_dask(jobs, run, scheduler, workers):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None)
         try:
-            return _gather_at(cluster, jobs, run)
+            return _gather_at(cluster, jobs, run, scheduler)
         finally:
             cluster.close()
 
 
-def _gather_at(scheduler, jobs, run):
+def _gather_at(cluster, jobs, run, scheduler):
+    """The jobs' rows from ``cluster`` (an address or a cluster), which ``--scheduler
+    scheduler`` named."""
     from distributed import Client
 
     try:
-        return _gather(Client(scheduler, timeout=30), jobs, run)
+        return _gather(Client(cluster, timeout=30), jobs, run)
     except (OSError, TimeoutError) as exc:
         raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
 

@@ -1,5 +1,5 @@
 """What a fork server imports before it forks srarap's worker processes (see
-:func:`srarap_cli.runtime.threads.process_context`): the jobs' code, and the workers' signal
+:func:`srarap_cli.runtime.threads.worker_processes`): the jobs' code, and the workers' signal
 dispositions, which every worker forked from the server keeps.
 
 A worker leaves SIGINT to the batch (a terminal's Ctrl-C reaches the whole group; the batch
