@@ -318,6 +318,38 @@ def test_a_signal_stops_a_batch_within_seconds_with_a_true_summary(slow_batch, s
     assert left == b"", "processes left behind"
 
 
+
+# a batch worker, just forked and still in multiprocessing's start-up, sends the signal to
+# the whole group itself: the window between the fork and the worker's own handlers
+SIGNAL_IN_A_WORKERS_START = """
+import os, signal, sys
+import multiprocessing.queues as q
+real = q.Queue._after_fork
+def after_fork(self):
+    if not os.environ.get("SENT"):
+        os.environ["SENT"] = "1"
+        os.killpg(0, signal.{name})
+    real(self)
+q.Queue._after_fork = after_fork
+sys.argv = ["srarap", "batch", "jobs.yaml", "-o", "out", "--workers", "2"]
+from srarap_cli.entry import main
+main()
+"""
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_as_a_worker_starts_is_one_line_and_its_code(slow_batch, tmp_path, signum):
+    """Workers start with SIGINT/SIGTERM held back until they have their own handlers: a
+    Ctrl-C reaching a worker just forked raised in its start-up (a traceback, a broken pool
+    reported as an internal error)."""
+    code = SIGNAL_IN_A_WORKERS_START.replace("{name}", signum.name)
+    p = subprocess.run([sys.executable, "-c", code], cwd=slow_batch, capture_output=True,
+                       start_new_session=True, timeout=120, env={**os.environ, "SENT": ""})
+    err = p.stderr.decode()
+    expected = {signal.SIGINT: 130, signal.SIGTERM: 143}[signum]
+    assert p.returncode == expected and "Traceback" not in err, err[-1500:]
+    assert "internal error" not in err and "interrupted" in err, err[-1500:]
+
 # --- a signal at any moment of a run's start and end -------------------------------------
 
 @settings(max_examples=max(BUDGET // 4, 10), deadline=None, phases=[Phase.generate],

@@ -36,7 +36,7 @@ from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..runtime.errors import InputError, NumericalError, SingularSystemError, excerpt
 from ..runtime.paths import refuse_overwriting_inputs
-from ..runtime.signals import Terminated
+from ..runtime.signals import SIGNALS, Terminated, deferred
 from ..runtime.threads import worker_processes
 from ..solver.settings import parse_mapping, resolve
 from ..solver.stop import StopReason
@@ -345,7 +345,11 @@ def _run_in_processes(jobs, run, workers):
                                    initargs=(os.getpid() if forked else None,))
         futures = []
         try:
-            futures = [pool.submit(run, job) for job in jobs]
+            # the workers start (on the first submit) with SIGINT/SIGTERM held back, until
+            # their initializer has taken them: a Ctrl-C that reached a worker just forked,
+            # still with this process's handlers, raised in its start-up and broke the pool
+            with deferred():
+                futures = [pool.submit(run, job) for job in jobs]
             rows = [f.result() for f in futures]
         except (KeyboardInterrupt, Terminated) as exc:
             _stop(pool)
@@ -366,6 +370,7 @@ def _worker_signals(batch_pid=None):
     server that ends with it): see :func:`_die_with`."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, lambda signum, frame: os._exit(143))
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)  # held back since the fork
     _die_with(batch_pid)
 
 
