@@ -18,6 +18,8 @@ import threading
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar, cast
 
+from .signals import deferred
+
 T = TypeVar("T")
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -140,14 +142,19 @@ def _start_fork_server(preload):
     forks keeps (started now: a library that sets its own preload later, as Dask does,
     would otherwise replace it)."""
     import multiprocessing
-    from multiprocessing import forkserver
+    from multiprocessing import forkserver, resource_tracker
 
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(list(preload))
     before = {name: os.environ.get(name) for name in _VARIABLES}
     os.environ.update(dict.fromkeys(_VARIABLES, "1"))
     try:
-        forkserver.ensure_running()
+        # the server starts with SIGINT/SIGTERM held back (the mask outlives exec) until
+        # its preload has set them: a Ctrl-C during its imports printed their traceback.
+        # Python's resource tracker first: starting it unblocks both, whatever the mask was
+        resource_tracker.ensure_running()
+        with deferred():
+            forkserver.ensure_running()
     finally:
         for name, value in before.items():
             if value is None:

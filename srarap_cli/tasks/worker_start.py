@@ -9,7 +9,11 @@ anywhere else would change that process's signals: only a fork server imports it
 """
 import signal
 
+from ..runtime.signals import SIGNALS
 from . import batch  # noqa: F401  (imported here so that workers start with it)
 
 signal.signal(signal.SIGINT, signal.SIG_IGN)
 signal.signal(signal.SIGTERM, signal.SIG_DFL)
+# the server started with them held back (runtime.threads): a SIGINT that came meanwhile is
+# now ignored, a SIGTERM ends it
+signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
