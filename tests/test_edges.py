@@ -326,8 +326,11 @@ import os, signal, sys
 import multiprocessing.queues as q
 real = q.Queue._after_fork
 def after_fork(self):
-    if not os.environ.get("SENT"):
-        os.environ["SENT"] = "1"
+    try:  # the first worker only
+        os.close(os.open(os.environ["SIGNAL_SENT"], os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+    except FileExistsError:
+        pass
+    else:
         os.killpg(0, signal.{name})
     real(self)
 q.Queue._after_fork = after_fork
@@ -344,7 +347,8 @@ def test_a_signal_as_a_worker_starts_is_one_line_and_its_code(slow_batch, tmp_pa
     reported as an internal error)."""
     code = SIGNAL_IN_A_WORKERS_START.replace("{name}", signum.name)
     p = subprocess.run([sys.executable, "-c", code], cwd=slow_batch, capture_output=True,
-                       start_new_session=True, timeout=120, env={**os.environ, "SENT": ""})
+                       start_new_session=True, timeout=120,
+                       env={**os.environ, "SIGNAL_SENT": str(tmp_path / "sent")})
     err = p.stderr.decode()
     expected = {signal.SIGINT: 130, signal.SIGTERM: 143}[signum]
     assert p.returncode == expected and "Traceback" not in err, err[-1500:]
