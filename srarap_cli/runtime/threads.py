@@ -18,6 +18,7 @@ import threading
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar, cast
 
+from .environment import environ_changed
 from .signals import deferred
 
 T = TypeVar("T")
@@ -146,21 +147,13 @@ def _start_fork_server(preload):
 
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(list(preload))
-    before = {name: os.environ.get(name) for name in _VARIABLES}
-    os.environ.update(dict.fromkeys(_VARIABLES, "1"))
-    try:
+    with environ_changed(dict.fromkeys(_VARIABLES, "1")):
         # the server starts with SIGINT/SIGTERM held back (the mask outlives exec) until
         # its preload has set them: a Ctrl-C during its imports printed their traceback.
         # Python's resource tracker first: starting it unblocks both, whatever the mask was
         resource_tracker.ensure_running()
         with deferred():
             forkserver.ensure_running()
-    finally:
-        for name, value in before.items():
-            if value is None:
-                os.environ.pop(name, None)
-            else:
-                os.environ[name] = value
     return context
 
 

@@ -15,7 +15,6 @@ A job is up to date when its output exists and the sidecar ``<output>.srarap.jso
 the same fingerprint (content of the mesh, the handle file and every file it names, settings,
 srarap version).
 """
-import contextlib
 import functools
 import hashlib
 import json
@@ -34,6 +33,7 @@ from ..io.mesh import format_mesh, read_mesh
 from ..io.mesh.formats import extensions
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
+from ..runtime.environment import environ_changed
 from ..runtime.errors import InputError, NumericalError, SingularSystemError, excerpt
 from ..runtime.paths import refuse_overwriting_inputs
 from ..runtime.signals import SIGNALS, Terminated, deferred
@@ -480,18 +480,11 @@ def _gather_at(cluster, jobs, run, scheduler):
         raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
 
 
-@contextlib.contextmanager
 def _without_dasks_trim_setting():
     """A Dask nanny started earlier in this process left its MALLOC_TRIM_THRESHOLD_ in
     ``os.environ``, where new workers would inherit it: hold it back while they spawn."""
-    value = os.environ.get("MALLOC_TRIM_THRESHOLD_")
-    if value == "65536":
-        del os.environ["MALLOC_TRIM_THRESHOLD_"]
-    try:
-        yield
-    finally:
-        if value == "65536":
-            os.environ["MALLOC_TRIM_THRESHOLD_"] = value
+    left = os.environ.get("MALLOC_TRIM_THRESHOLD_") == "65536"
+    return environ_changed({"MALLOC_TRIM_THRESHOLD_": None} if left else {})
 
 
 
