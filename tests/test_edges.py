@@ -355,6 +355,40 @@ def test_a_signal_as_a_worker_starts_is_one_line_and_its_code(slow_batch, tmp_pa
     assert "internal error" not in err and err.count("srarap: error:") <= 1, err[-1500:]
 
 
+# a second SIGTERM comes while a batch stopped by the first writes its summary (a CI
+# runner's timeout sends more than one): every interpreter imports this sitecustomize, and
+# the batch's own sends the signal as its summary is committed
+SECOND_SIGNAL_AT_THE_SUMMARY = """
+import os, signal
+from srarap_cli.cli import batch
+real = batch.commit_files
+def commit_files(files):
+    os.kill(os.getpid(), signal.SIGTERM)
+    return real(files)
+batch.commit_files = commit_files
+"""
+
+
+def test_a_second_signal_while_a_stopped_batch_writes_its_summary_keeps_the_summary(
+        slow_batch, tmp_path):
+    (tmp_path / "sitecustomize.py").write_text(SECOND_SIGNAL_AT_THE_SUMMARY)
+    out = tmp_path / "out"
+    p = subprocess.Popen([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o",
+                          str(out), "--workers", "2"], cwd=slow_batch, stderr=subprocess.PIPE,
+                         env={**os.environ, "PYTHONPATH": str(tmp_path)})
+    for _ in range(600):  # until the workers run (the manifest is read by then)
+        if subprocess.run(["pgrep", "-P", str(p.pid)], capture_output=True).stdout:
+            break
+        time.sleep(0.1)
+    time.sleep(0.5)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 143 and "Traceback" not in err.decode(), err.decode()[-800:]
+    rows = json.loads((out / "summary.json").read_text())
+    assert len(rows) == 6 and "interrupted" in {r["status"] for r in rows}
+    assert "terminated: the jobs not finished are marked interrupted" in err.decode()
+
+
 # the batch sends the signal to its group as soon as its fork server has been started: the
 # window while the server (a fresh interpreter) imports the workers' code
 SIGNAL_AS_THE_FORK_SERVER_STARTS = """

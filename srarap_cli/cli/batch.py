@@ -10,7 +10,7 @@ import click
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..runtime.errors import OutputError
-from ..runtime.signals import Terminated
+from ..runtime.signals import Terminated, block
 from ..tasks.batch import (
     SUMMARY_FIELDS,
     BatchInterrupted,
@@ -71,6 +71,9 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
                                   pictures=report is not None), None
     except BatchInterrupted as exc:  # the workers are stopped: say what finished
         rows, stopped = exc.rows, exc.signal
+        # the summary is what is left to do: a second Ctrl-C or SIGTERM (a CI runner's
+        # timeout sends more than one) must not cost it; the exit code says stopped anyway
+        block()
     pictures = {r["job"]: r.pop("pictures", {}) for r in rows}
     files = [(os.path.join(out, "summary.csv"), _csv(rows).encode()),
              (os.path.join(out, "summary.json"), (json.dumps(rows, indent=2) + "\n").encode())]

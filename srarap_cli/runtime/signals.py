@@ -83,9 +83,20 @@ def deferred() -> Iterator[None]:
 
 def block() -> None:
     """Hold SIGINT/SIGTERM back from now on (the ``srarap`` process is on its way out; in a
-    process that hosts srarap as a library, nothing changes)."""
+    process that hosts srarap as a library, nothing changes): masked in this thread, and
+    only recorded should one still come. A mask is one thread's: a thread still running
+    (a stopped process pool's) takes a signal this one holds back, and Python then ran the
+    handler here all the same (a stopped batch lost its summary to a second SIGTERM)."""
     if OWNED:
         signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+        if threading.current_thread() is threading.main_thread():
+            for signum in SIGNALS:
+                signal.signal(signum, _record)
+
+
+def _record(signum, _frame):
+    global RECEIVED
+    RECEIVED = RECEIVED or signum
 
 
 def pending() -> signal.Signals | int:

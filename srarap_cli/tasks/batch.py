@@ -20,9 +20,7 @@ import hashlib
 import json
 import math
 import os
-import signal
 import time
-from concurrent.futures import ProcessPoolExecutor
 from importlib import metadata
 from typing import Any
 
@@ -36,7 +34,7 @@ from ..runtime.commit import commit_files
 from ..runtime.environment import environ_changed
 from ..runtime.errors import InputError, NumericalError, SingularSystemError, excerpt
 from ..runtime.paths import refuse_overwriting_inputs
-from ..runtime.signals import SIGNALS, Terminated, deferred
+from ..runtime.signals import Terminated
 from ..runtime.threads import worker_processes
 from ..solver.settings import parse_mapping, resolve
 from ..solver.stop import StopReason
@@ -44,6 +42,7 @@ from .compare import beyond, compare_meshes
 from .job_pictures import difference_picture, energy_picture, shape_picture
 from .pipeline import deform_mesh
 from .report import EXIT_CODES, encode_png
+from .worker_pool import WORKER_START, PoolStopped, death_note, run_in_processes
 
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
 #: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason` (empty for a job that
@@ -327,101 +326,21 @@ def interrupted_row(job: Job) -> Row:
             "tol": None, "exit_code": EXIT_CODES["interrupted"]}
 
 
-#: what the server that forks worker processes imports first: the jobs' code and the workers'
-#: signal dispositions
-WORKER_START = "srarap_cli.tasks.worker_start"
-#: seconds the workers get to stop after SIGTERM before they are killed
-STOP_GRACE = 2.0
-
-
 def _run_in_processes(jobs, run, workers):
-    """Jobs in ``workers`` processes, rows in manifest order. A signal to this process
-    stops the workers (SIGTERM, then SIGKILL after :data:`STOP_GRACE` seconds), keeps the
-    rows of the jobs that finished and raises :class:`BatchInterrupted`."""
-    with worker_processes([WORKER_START]) as context:
-        forked = context.get_start_method() == "fork"
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
-                                   initializer=_worker_signals,
-                                   initargs=(os.getpid() if forked else None,))
-        futures = []
-        try:
-            # the workers start (on the first submit) with SIGINT/SIGTERM held back, until
-            # their initializer has taken them: a Ctrl-C that reached a worker just forked,
-            # still with this process's handlers, raised in its start-up and broke the pool
-            with deferred():
-                futures = [pool.submit(run, job) for job in jobs]
-            rows = [f.result() for f in futures]
-        except (KeyboardInterrupt, Terminated) as exc:
-            _stop(pool)
-            finished = {k: f.result() for k, f in enumerate(futures)
-                        if f.done() and not f.cancelled() and f.exception() is None}
-            raise BatchInterrupted([finished.get(k) or interrupted_row(job)
-                                    for k, job in enumerate(jobs)], exc) from None
-        pool.shutdown()
-        return rows
-
-
-def _worker_signals(batch_pid=None):
-    """A worker leaves SIGINT to the batch (a terminal's Ctrl-C reaches the whole group: the
-    batch stops the workers and reports) and leaves at once on SIGTERM, from the batch: an
-    exception raised there could land in any destructor and print a traceback. Its commits
-    hold signals back while they rename, and the temporary files it staged are swept by
-    the next write into their folder. It never outlives its parent (the batch, or the fork
-    server that ends with it): see :func:`_die_with`."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, lambda signum, frame: os._exit(143))
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)  # held back since the fork
-    _die_with(batch_pid)
-
-
-def _die_with(batch_pid):
-    """Have the kernel kill this worker when its parent ends (Linux), and leave now if the
-    batch (``batch_pid``, the parent of a forked worker) already has. A worker forked just
-    as a signal stopped the batch, before the batch knew of it, escaped the batch's
-    SIGTERM/SIGKILL: it then waited for a job forever, and held the batch's standard error
-    open (a CI test waiting for its end timed out)."""
+    """Jobs in ``workers`` processes (:mod:`.worker_pool`), rows in manifest order; a signal
+    raises :class:`BatchInterrupted` with the rows of the jobs that finished."""
     try:
-        import ctypes
-
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):  # not Linux: the batch's own stop has to do
-        pass
-    if batch_pid is not None and os.getppid() != batch_pid:
-        os._exit(143)
+        return run_in_processes(jobs, run, workers, _lost_row)
+    except PoolStopped as exc:
+        raise BatchInterrupted([exc.rows.get(k) or interrupted_row(job)
+                                for k, job in enumerate(jobs)], exc.signal) from None
 
 
-def _stop(pool):
-    processes = list(getattr(pool, "_processes", {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for p in processes:
-        if p.is_alive():
-            p.terminate()
-    deadline = time.monotonic() + STOP_GRACE
-    for p in processes:
-        p.join(max(deadline - time.monotonic(), 0.0))
-        if p.is_alive():
-            p.kill()
-            p.join(1.0)
-    _let_exit_go(pool)
-
-
-def _let_exit_go(pool):
-    """Keep the interpreter's exit from waiting on the pool's threads once its workers are
-    gone. At exit Python joins the executor's manager thread and the call queue's feeder
-    thread without a timeout; with the workers killed mid-job, under load, one of them could
-    still be waiting (a batch stopped by a signal took 39 s, once more than 60, to end after
-    its summary was written). Both are given the grace period, then left behind."""
-    from concurrent.futures import process
-
-    queue = getattr(pool, "_call_queue", None)
-    if queue is not None:
-        queue.cancel_join_thread()
-    thread = getattr(pool, "_executor_manager_thread", None)
-    if thread is not None:
-        thread.join(STOP_GRACE)
-        if thread.is_alive():
-            getattr(process, "_threads_wakeups", {}).pop(thread, None)
+def _lost_row(job, exitcode):
+    """The summary row of a job whose worker process died when it ran alone."""
+    code = 128 - exitcode if exitcode < 0 else exitcode or 1
+    return {**interrupted_row(job), "status": "failed", "exit_code": code,
+            "message": f"not finished: {death_note(exitcode)}"}
 
 
 #: what srarap's own Dask workers get instead of Dask's defaults: one BLAS thread, and glibc's
