@@ -111,11 +111,11 @@ def _run_pool(context, workers, jobs, run, ids, rows):
                     broken.append(k)
             if not broken:
                 _top_up(pool, queue, running, workers, jobs, run, processes)
+        pool.shutdown()
+        return sorted(broken), _dead_exitcode(processes) if broken else 0
     except (KeyboardInterrupt, Terminated) as exc:
         _stop(pool)
         raise PoolStopped(rows, exc) from None
-    pool.shutdown()
-    return sorted(broken), _dead_exitcode(processes) if broken else 0
 
 
 def _top_up(pool, queue, running, workers, jobs, run, processes):
