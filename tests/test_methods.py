@@ -45,7 +45,7 @@ def test_relaxation_and_symmetric_linear_step_reach_the_same_minimum():
     assert a.converged and b.converged
     S, s = relax.edges.covariance(b.positions)
     lam_min = np.linalg.eigvalsh(membrane_matrices(S, s))[:, 0]
-    row = relax.alpha * relax.area * relax.graph.cell_sum(symmetric_weights(relax.graph))
+    row = relax.settings.alpha * relax.area * relax.graph.cell_sum(symmetric_weights(relax.graph))
     kappa = float((lam_min / row).max())
     gap = abs(a.energy - b.energy) / b.energy
     assert gap <= kappa, (gap, kappa)

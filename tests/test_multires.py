@@ -248,7 +248,7 @@ def test_every_method_runs_through_multires_and_keeps_a_translation_exact(method
     d = MultiresDeformer(V, F, np.arange(6), size=30, method=method)
     r = d.solve(V[:6] + [0.5, -1.0, 2.0], max_iter=20)
     assert np.abs(r.positions - (V + [0.5, -1.0, 2.0])).max() < 1e-9
-    assert d.coarse_deformer.method == method
+    assert d.coarse_deformer.settings.method == method
 
 
 def test_parts_without_handles_stay_at_rest_with_the_same_warning_as_a_direct_solve():

@@ -192,15 +192,9 @@ class Deformer:
                  **options: Any) -> None:
         self.settings = with_keywords(settings, options, ("setup", "solve"), "Deformer")
         s = self.settings
-        alpha, feedback, weights, method = s.alpha, s.feedback, s.weights, s.method
-        self.handle_rotors = s.handle_rotors
         self.V, self.F = api_checks.mesh_arrays(V, F)
-        self.weights = weights
-        self.graph = cell_graph(self.V, self.F, weights)
-        self.alpha = float(alpha)
-        self.feedback = float(feedback)
+        self.graph = cell_graph(self.V, self.F, s.weights)
         self.area = self.graph.area if area is None else float(area)
-        self.method, self.sweeps = method, s.sweeps
         self.constrained = api_checks.vertex_ids(constrained, len(self.V))
         self._mask = np.zeros(len(self.V), dtype=bool)
         self._mask[self.constrained] = True
@@ -215,7 +209,7 @@ class Deformer:
         self.edges = RestEdges(self.graph, self.V)
         self.energy_scale = max(float(self.graph.c @ self.edges.q_sq), 1e-300)
         self.diagonal = float(np.linalg.norm(np.ptp(self.V, axis=0)))
-        self._bending_alpha = self.alpha if METHODS[method].bending else 0.0
+        self._bending_alpha = s.alpha if METHODS[s.method].bending else 0.0
         self._poisson: PoissonSolver | None = None
         self._local_step: Any = None
         self._response: LinearResponse | None = None
@@ -226,16 +220,17 @@ class Deformer:
         """Factor the Poisson matrix and build the local step, if not done yet."""
         if self._poisson is None:
             self._poisson = PoissonSolver(self.graph, self._mask)
-            extra = {"sweeps": self.sweeps} if self.method == "sr-relax" else {}
-            self._local_step = METHODS[self.method](self.edges, self._rotor_mask(),
-                                                    self.alpha * self.area, self.feedback,
-                                                    **extra)
+            s = self.settings
+            extra = {"sweeps": s.sweeps} if s.method == "sr-relax" else {}
+            self._local_step = METHODS[s.method](self.edges, self._rotor_mask(),
+                                                 s.alpha * self.area, s.feedback,
+                                                 **extra)
         return self
 
     def _rotor_mask(self):
         """Vertices whose rotors the local step takes from their own rows (see
         ``handle_rotors``), and every vertex nothing can move."""
-        if self.handle_rotors == "lagged" or not self.feedback > 0:
+        if self.settings.handle_rotors == "lagged" or not self.settings.feedback > 0:
             return self._mask
         g, held = self.graph, np.zeros_like(self._mask)
         held[g.I[self._mask[g.I] & ~self._mask[g.J]]] = True
