@@ -1,5 +1,6 @@
 """Previews, distortion maps and energy plots."""
 import os
+import warnings
 
 import meshio
 import numpy as np
@@ -140,3 +141,18 @@ def test_the_default_up_axis_stands_the_sample_bar_on_its_base(tmp_path):
     tip, base = np.argwhere(blue).mean(axis=0), np.argwhere(red).mean(axis=0)  # (row, col)
     assert base[0] - tip[0] > 0.6 * img.shape[0]  # tip far above the base: upright
     assert abs(base[1] - tip[1]) < 0.05 * img.shape[1]  # one above the other
+
+
+def test_plot_of_a_log_that_reaches_zero_energy_draws_it_without_warnings(tmp_path):
+    """An exact solve (a rigid motion of the handles) ends at energy 0: a log axis would
+    drop those points, and matplotlib warned on stderr."""
+    log = tmp_path / "exact.csv"
+    log.write_text("iteration,membrane,bending,total,rel_change,max_move,seconds,step,stop\n"
+                   "0,1e-3,0,1e-3,,0,0.01,start,\n1,0,0,0,1,0.1,0.02,plain,converged\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = invoke("plot", log, "-o", tmp_path / "e.png")
+    assert r.exit_code == 0 and r.stderr == "", r.stderr
+    picture = imread(str(tmp_path / "e.png"))[..., :3]
+    # the line across both panels (about 1,200 pixels; a log axis kept about 530 of them)
+    assert (np.abs(picture - [0.12, 0.47, 0.71]).max(axis=-1) < 0.05).sum() > 900

@@ -14,6 +14,7 @@ from ..runtime.commit import commit_files
 from ..runtime.errors import InputError
 from ..tasks.frames import animated_gif, contact_sheet, frame_pictures, sheet_choice
 from ..tasks.info import up_axis
+from ..tasks.log_axis import decades_axis
 from ..tasks.preview import preview_png
 from ..tasks.render import VIEWS
 from .common import check_output_path, guarded, input_format_option, read_any_mesh, refuse_overwrite
@@ -161,15 +162,18 @@ def plot(logs: tuple[str, ...], out: str, size: str) -> None:
 
     tables = [(path, _read_log(path)) for path in logs]  # every log checked before drawing
     fig, (a, b) = plt.subplots(1, 2, figsize=(w / 100, h / 100), dpi=100)
-    times = []
+    times, energies = [], []
     for path, rows in tables:
         it = [float(r["iteration"]) for r in rows]
         e = [float(r["total"]) for r in rows]
         t = [max(float(r["seconds"]), 1e-4) for r in rows]
         times += t
-        a.semilogy(it, e, label=os.path.basename(path))
-        b.semilogy(t, e, label=os.path.basename(path))
-    _time_axis(b, times)
+        energies += e
+        a.plot(it, e, label=os.path.basename(path))
+        b.plot(t, e, label=os.path.basename(path))
+    for ax in (a, b):
+        decades_axis(ax, "y", energies, "{:.4g}")
+    decades_axis(b, "x", times)
     for ax, xl in ((a, "iteration"), (b, "wall time [s]")):
         ax.set_xlabel(xl)
         ax.set_ylabel("total energy")
@@ -180,18 +184,6 @@ def plot(logs: tuple[str, ...], out: str, size: str) -> None:
     fig.savefig(buf, format="png", metadata={"Software": None})
     plt.close(fig)
     commit_files([(out, buf.getvalue())])
-
-
-def _time_axis(ax, times):
-    """Seconds on a log axis when they span more than a decade, labelled at its powers of
-    ten only (the minor ticks' labels ran into each other); a linear axis otherwise."""
-    from matplotlib.ticker import FuncFormatter, NullFormatter
-
-    if not times or max(times) < 10 * min(times):
-        return
-    ax.set_xscale("log")
-    ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))
-    ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 def _read_log(path):

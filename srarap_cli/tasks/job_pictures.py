@@ -9,6 +9,7 @@ import numpy as np
 from ..io.handles import Constraints
 from ..io.mesh.mesh import Mesh
 from .info import up_axis
+from .log_axis import decades_axis
 from .preview import UP
 from .render import face_colors, render_png
 
@@ -47,15 +48,11 @@ def energy_picture(log: Sequence[dict[str, Any]]) -> bytes:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import FuncFormatter, NullFormatter
 
     fig, ax = plt.subplots(figsize=(THUMBNAIL[0] / 100, THUMBNAIL[1] / 100), dpi=100)
-    energy = [max(r["total"], 1e-300) for r in log]
+    energy = [r["total"] for r in log]
     ax.plot([r["iteration"] for r in log], energy)
-    if max(energy) > 10 * min(energy):  # a log axis only where it spans decades
-        ax.set_yscale("log")
-        ax.yaxis.set_minor_formatter(NullFormatter())
-    ax.yaxis.set_major_formatter(FuncFormatter(lambda y, _: f"{y:.4g}"))
+    decades_axis(ax, "y", energy, "{:.4g}")
     ax.set_xlabel("iteration", fontsize=7)
     ax.set_ylabel("energy", fontsize=7)
     ax.tick_params(labelsize=6)
