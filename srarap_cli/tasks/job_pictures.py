@@ -44,7 +44,7 @@ def difference_picture(rest: Mesh, deformed: Mesh, distances: np.ndarray, tol: f
 
 
 def energy_picture(log: Sequence[dict[str, Any]]) -> bytes:
-    """Total energy against iteration (log scale): PNG bytes."""
+    """Total energy against iteration (a log axis where it spans decades): PNG bytes."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
