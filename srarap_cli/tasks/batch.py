@@ -361,7 +361,14 @@ LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRON,
                 "distributed.worker.profile.enabled": False,
                 "distributed.admin.tick.interval": "1s",
                 "distributed.admin.system-monitor.interval": "5s",
-                "distributed.worker.memory.monitor-interval": "1s"}
+                "distributed.worker.memory.monitor-interval": "1s",
+                # one task per worker at a time: the death of a worker then counts against
+                # the task it ran only (Dask's 1.1 queued a second one there, which failed
+                # with it), and a task whose worker died runs once more, then fails (Dask's
+                # default, 3 more times, ran a job too large for the machine into its limit
+                # 4 times)
+                "distributed.scheduler.worker-saturation": 1.0,
+                "distributed.scheduler.allowed-failures": 1}
 
 
 def _run_on_dask(jobs, run, scheduler, workers):
@@ -418,13 +425,37 @@ def _silence_dask():
 
 
 def _gather(client, jobs, run):
+    """The rows of ``jobs`` run on ``client``'s cluster. A job Dask gave up on (its worker
+    died each time it ran it: Dask's KilledWorker) is a failed row, not the batch's end."""
     with client:
         futures = client.map(run, jobs, pure=False)
+        rows = []
         try:
-            return client.gather(futures)
+            # one at a time: a finished task whose worker died is computed again, and its
+            # result() waits for that
+            for future, job in zip(futures, jobs):
+                rows.append(_dask_row(future, job))
         except (KeyboardInterrupt, Terminated) as exc:
             _silence_dask()
             rows = [f.result() if f.status == "finished" else interrupted_row(job)
                     for f, job in zip(futures, jobs)]
             client.cancel(futures)
             raise BatchInterrupted(rows, exc) from None
+        return rows
+
+
+def _dask_row(future, job):
+    """The job's row from its task; a failed row when the task ended without one
+    (``run_job`` itself never raises: its worker died, or the cluster lost it)."""
+    import asyncio
+
+    try:
+        return future.result()
+    except (Exception, asyncio.CancelledError) as exc:
+        if type(exc).__name__ == "KilledWorker":
+            reason = ("its worker process died each time Dask ran it (the system may have "
+                      "run out of memory)")
+        else:
+            reason = f"Dask: {type(exc).__name__}: {(str(exc).splitlines() or [''])[0][:200]}"
+        return {**interrupted_row(job), "status": "failed", "exit_code": 1,
+                "message": f"not finished: {reason}"}
