@@ -338,9 +338,14 @@ def _run_in_processes(jobs, run, workers):
 
 def _lost_row(job, exitcode):
     """The summary row of a job whose worker process died when it ran alone."""
-    code = 128 - exitcode if exitcode < 0 else exitcode or 1
-    return {**interrupted_row(job), "status": "failed", "exit_code": code,
-            "message": f"not finished: {death_note(exitcode)}"}
+    return _unfinished_row(job, death_note(exitcode),
+                           128 - exitcode if exitcode < 0 else exitcode or 1)
+
+
+def _unfinished_row(job, reason, exit_code):
+    """The summary row of a job that failed without a row of its own (its process died)."""
+    return {**interrupted_row(job), "status": "failed", "exit_code": exit_code,
+            "message": f"not finished: {reason}"}
 
 
 #: what srarap's own Dask workers get instead of Dask's defaults: one BLAS thread, and glibc's
@@ -457,5 +462,4 @@ def _dask_row(future, job):
                       "run out of memory)")
         else:
             reason = f"Dask: {type(exc).__name__}: {(str(exc).splitlines() or [''])[0][:200]}"
-        return {**interrupted_row(job), "status": "failed", "exit_code": 1,
-                "message": f"not finished: {reason}"}
+        return _unfinished_row(job, reason, 1)
