@@ -8,8 +8,9 @@ with its allocator settings) in this process and prints:
 1. after the setup: resident memory, and the arrays, sparse matrices and SuperLU factors
    reachable from the solver object, summed by owner (attribute path; closures and bound
    methods followed). A SuperLU factor is counted at 4 bytes of index per entry plus its
-   value size, double or single as the factor was made (``--single-above``: the size from
-   which the solver factors in single precision, ``solver.linalg.LARGE``);
+   value size, read from the factor (the precision of a solve's answer; until 2026-11-26
+   this guessed single precision from a size, which counted the double-precision Poisson
+   factor at two thirds of its size);
 2. at the highest resident memory seen during the solve (sampled every 0.3 s): the memory
    numpy and Python had allocated (tracemalloc), by allocation site, and what was not theirs
    (SuperLU, libigl, the allocator's free lists).
@@ -38,14 +39,15 @@ def resident():
     return tuple(int(fields[k].split()[0]) * 1024 for k in ("VmRSS", "VmHWM"))
 
 
-def _bytes(obj, single_above):
+def _bytes(obj):
     if isinstance(obj, np.ndarray):
         return obj.nbytes if obj.base is None else 0
     if sp.issparse(obj):
         return sum(getattr(obj, a).nbytes for a in ("data", "indices", "indptr", "row", "col")
                    if hasattr(obj, a))
     if type(obj).__name__ == "SuperLU":
-        value = 4 if obj.shape[0] > single_above else 8
+        # SuperLU answers in its factor's precision, whatever the right-hand side's
+        value = obj.solve(np.zeros(obj.shape[0], dtype=np.float32)).itemsize
         return obj.nnz * (4 + value)
     return 0
 
@@ -65,7 +67,7 @@ def _children(obj):
     return [(f".{s}", getattr(obj, s)) for s in getattr(obj, "__slots__", ()) if hasattr(obj, s)]
 
 
-def owners(root, name, single_above, depth=4):
+def owners(root, name, depth=4):
     """{owner path (its first ``depth`` steps): bytes} of everything reachable from ``root``,
     each object counted once."""
     seen, found = set(), collections.Counter()
@@ -75,7 +77,7 @@ def owners(root, name, single_above, depth=4):
         if id(obj) in seen or isinstance(obj, LEAVES):
             continue
         seen.add(id(obj))
-        size = _bytes(obj, single_above)
+        size = _bytes(obj)
         if size:
             found[path + (" (SuperLU)" if type(obj).__name__ == "SuperLU" else "")] += size
             continue
@@ -123,7 +125,6 @@ def main():
     import srarap_cli.tasks.pipeline as pipeline
     from srarap_cli.io.handles import load_handles
     from srarap_cli.io.mesh import read_mesh
-    from srarap_cli.solver.linalg import LARGE
 
     mesh = read_mesh(args.mesh)
     constraints = load_handles(args.handles, mesh.vertices)
@@ -136,7 +137,7 @@ def main():
         solver, notes = command_solver(*a, **k)
         rss, hwm = resident()
         print(f"after the setup: resident {rss / 1e9:.2f} GB (peak so far {hwm / 1e9:.2f} GB)")
-        _print_owners(owners(solver, "solver", LARGE), args.top)
+        _print_owners(owners(solver, "solver"), args.top)
         state["start"] = time.perf_counter()
         threading.Thread(target=watch_peak, args=(state,), daemon=True).start()
         return solver, notes
