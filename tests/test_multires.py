@@ -354,3 +354,55 @@ def test_a_warm_solve_calls_on_the_coarse_mesh_only_when_it_needs_many_iteration
     assert "corrected" not in steps[:mr.WARM_UNCORRECTED + 1]
     for r in (near, far):
         assert np.abs(r.positions - cold.positions).max() < 1e-4 * diagonal(V)
+
+
+def _slow_full_resolution_prepare(monkeypatch, n, before):
+    """Make the full-resolution Deformer's factorization (``n`` vertices) run ``before()``."""
+    from srarap_cli.solver.deformer import Deformer
+    real = Deformer.prepare
+
+    def prepare(self):
+        if len(self.V) == n and self._poisson is None:
+            before()
+        return real(self)
+
+    monkeypatch.setattr(Deformer, "prepare", prepare)
+
+
+def test_the_coarse_solve_runs_while_the_full_resolution_factorization_finishes(spot,
+                                                                                monkeypatch):
+    import threading
+    p = problem(read_mesh(SPOT), load_handles(NOD, spot[0]))
+    coarse_started, waited = threading.Event(), []
+    # the factorization ends only once the coarse solve has begun (or after 30 s)
+    _slow_full_resolution_prepare(monkeypatch, len(p.V),
+                                  lambda: waited.append(coarse_started.wait(30)))
+    d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500)
+    coarse_solve = d.coarse_deformer.solve
+
+    def solve(*args, **kwargs):
+        coarse_started.set()
+        return coarse_solve(*args, **kwargs)
+
+    d.coarse_deformer.solve = solve
+    r = d.solve(p.targets)
+    assert waited == [True]
+    assert r.stages["factor"] > 0
+    monkeypatch.undo()
+    # the same answer as a solver whose setup had ended before its solve began
+    ref = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500)
+    assert ref.fine.poisson is not None
+    assert np.array_equal(r.positions, ref.solve(p.targets).positions)
+
+
+def test_a_failed_full_resolution_factorization_is_raised_by_the_solve(spot, monkeypatch):
+    from srarap_cli.runtime.errors import NumericalError
+    p = problem(read_mesh(SPOT), load_handles(NOD, spot[0]))
+
+    def fail():
+        raise NumericalError("the Poisson matrix is singular")
+
+    _slow_full_resolution_prepare(monkeypatch, len(p.V), fail)
+    d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500)
+    with pytest.raises(NumericalError, match="singular"):
+        d.solve(p.targets)
