@@ -406,3 +406,23 @@ def test_a_failed_full_resolution_factorization_is_raised_by_the_solve(spot, mon
     d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500)
     with pytest.raises(NumericalError, match="singular"):
         d.solve(p.targets)
+
+
+def test_a_failed_coarse_solve_leaves_no_factorization_running(spot, monkeypatch):
+    # a batch worker's next job must not share its core with the last one's leftovers
+    import time
+
+    from srarap_cli.runtime.errors import NumericalError
+    p = problem(read_mesh(SPOT), load_handles(NOD, spot[0]))
+    factored = []
+    _slow_full_resolution_prepare(monkeypatch, len(p.V),
+                                  lambda: (time.sleep(1.0), factored.append(True)))
+    d = MultiresDeformer(p.V, p.F, p.ids, p.labels, size=1500)
+
+    def fail(*args, **kwargs):
+        raise NumericalError("the coarse solve produced non-finite values")
+
+    d.coarse_deformer.solve = fail
+    with pytest.raises(NumericalError, match="non-finite"):
+        d.solve(p.targets)
+    assert factored == [True]

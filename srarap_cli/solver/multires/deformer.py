@@ -1,6 +1,7 @@
 """Multiresolution SR-ARAP (paper section 7): solve on a coarse subset mesh, then either carry
 the result to the full mesh the paper's way (rotors spread harmonically, one Poisson solve) or
 start full-resolution iterations from it (coarse-to-fine)."""
+import contextlib
 import time
 from collections.abc import Callable
 from concurrent.futures import Future
@@ -152,8 +153,9 @@ class MultiresDeformer:
     in refine mode, on beside the coarse level's setup and the first solve's coarse
     iterations, which need none of it: the constructor returns once the fine Deformer is
     built, and the first solve waits for its factorizations only when its full-resolution
-    stage begins (an error there is raised by that solve). The answers are the same bit for
-    bit: the two threads share no data.
+    stage begins (an error there is raised by that solve; a setup or solve that fails first
+    waits for the background work, so that nothing of it runs on). The answers are the same
+    bit for bit: the two threads share no data.
 
     Parameters
     ----------
@@ -195,7 +197,7 @@ class MultiresDeformer:
                  **options: Any) -> None:
         self.settings = with_keywords(settings, options, ("setup", "solve", "build"),
                                       "MultiresDeformer")
-        self.mode = mode = self.settings.multires_mode
+        self.mode = self.settings.multires_mode
         start, peak = time.perf_counter(), memory.start()
         self.V, self.F = api_checks.mesh_arrays(V, F)
         self.constrained = api_checks.vertex_ids(constrained, len(self.V))
@@ -213,26 +215,33 @@ class MultiresDeformer:
         built: Future[Deformer] = Future()
         self._prepared: Callable[[], float] | None = background(
             partial(self._fine_setup, area, built))
+        try:
+            self._build_levels(size, groups, cache, built, start)
+        except Exception:
+            self._settle()
+            raise
+        self.memory = {"setup": memory.stop(peak)}
+
+    def _build_levels(self, size, groups, cache, built, start):
+        """Everything of the setup but the full-resolution factorizations (see __init__)."""
         self.coarse, self.cache_hit, notes = coarse_mesh(self.V, self.F, size, groups, cache)
         self.stages = {"simplify": time.perf_counter() - start}
         self._fine, self._own_setup = built.result(), 0.0
         self.area = self._fine.area
         self.direct = self._no_gain()
         if self.direct is not None:
-            memory.stop(peak)
             return
         self._build_coarse(cache)
         mark = time.perf_counter()
-        if mode == "refine":
+        if self.mode == "refine":
             self._nearest = nearest_coarse(self._fine.edges, self.coarse.vertices)
         else:
             self._build_transfer()
         self._own_setup = time.perf_counter() - mark
-        if mode != "refine":  # nothing left to factor beside the solve
+        if self.mode != "refine":  # nothing left to factor beside the solve
             self._ready()
         self.warnings = (self._fine.warnings + notes
                          + [f"multires: {w}" for w in self.coarse.warnings])
-        self.memory = {"setup": memory.stop(peak)}
 
     @property
     def fine(self) -> Deformer:
@@ -249,6 +258,15 @@ class MultiresDeformer:
         if self._prepared is not None:
             seconds, self._prepared = self._prepared(), None
             self.stages["factor"] = seconds + self._own_setup
+
+    def _settle(self):
+        """After an error: wait for the full-resolution setup, its own outcome dropped, so
+        that nothing of a failed call runs on (a batch worker's next job would share its
+        core with it)."""
+        wait, self._prepared = self._prepared, None
+        if wait is not None:
+            with contextlib.suppress(Exception):
+                wait()
 
     def _no_gain(self):
         """The full-resolution Deformer when the simplification kept more than half the
@@ -334,8 +352,12 @@ class MultiresDeformer:
         warm = None if initial is None else (np.asarray(initial[0])[cv],
                                               np.asarray(initial[1])[cv])
         peak = memory.start()
-        coarse = self.coarse_deformer.solve(targets[self._coarse_slots], initial=warm,
-                                            callback=callback, settings=s, start=start)
+        try:
+            coarse = self.coarse_deformer.solve(targets[self._coarse_slots], initial=warm,
+                                                callback=callback, settings=s, start=start)
+        except Exception:
+            self._settle()
+            raise
         coarse_seconds = time.perf_counter() - begin
         self._ready()
         stages = dict(self.stages, coarse_solve=coarse_seconds)
