@@ -206,3 +206,34 @@ def test_a_command_run_in_process_gives_the_host_its_signal_handlers_back(case, 
     finally:
         for signum, handler in saved.items():
             signal.signal(signum, handler)
+
+
+DEFERRED_PROBE = """
+import os, signal, threading, time
+from srarap_cli.runtime import signals
+signals.own()
+# a thread that holds no signal back: the kernel hands it what the main thread masks
+threading.Thread(target=lambda: [time.sleep(0.001) for _ in iter(int, 1)], daemon=True).start()
+where = "inside"
+try:
+    with signals.deferred():
+        with signals.deferred():
+            os.kill(os.getpid(), signal.SIG{name})
+            time.sleep(0.2)
+            sum(range(100000))
+            where = "after the inner block"
+        time.sleep(0.1)
+        sum(range(100000))
+        where = "after the outer block"
+    where = "never"
+except (KeyboardInterrupt, signals.Terminated) as exc:
+    print(where, type(exc).__name__)
+"""
+
+
+@pytest.mark.parametrize("name, raised", [("INT", "KeyboardInterrupt"), ("TERM", "Terminated")])
+def test_a_signal_held_back_by_deferred_waits_for_the_block_also_beside_other_threads(
+        name, raised):
+    p = subprocess.run([sys.executable, "-c", DEFERRED_PROBE.replace("{name}", name)],
+                       capture_output=True, text=True, timeout=60)
+    assert p.stdout.strip() == f"after the outer block {raised}", p.stdout + p.stderr

@@ -73,12 +73,37 @@ def routed() -> Iterator[None]:
 
 @contextlib.contextmanager
 def deferred() -> Iterator[None]:
-    """Hold SIGINT/SIGTERM back inside the block; one that arrived is raised after it."""
+    """Hold SIGINT/SIGTERM back inside the block; one that arrived is raised after it.
+
+    Masked in this thread, and, in the main thread (where Python runs signal handlers),
+    only recorded inside the block: a mask is one thread's, and the kernel hands a signal
+    to another thread that does not hold it back (a multiresolution setup's background
+    thread), after which Python ran the handler in the main thread inside the block all
+    the same."""
     blocked = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    held: list[int] = []
+    before = _hold_handlers(held.append)
     try:
         yield
     finally:
+        for signum, handler in before.items():
+            signal.signal(signum, handler)
         signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+        if held:  # to this thread: it waits while an enclosing block still holds it back
+            signal.raise_signal(held[0])
+
+
+def _hold_handlers(record: Callable[[int], None]) -> dict[int, Any]:
+    """In the main thread, replace the Python handlers of SIGINT/SIGTERM with ``record``
+    (of the signal number); returns those replaced (none where a handler was not set from
+    Python and so cannot be put back)."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    before: dict[int, Any] = {signum: signal.getsignal(signum) for signum in SIGNALS}
+    before = {signum: handler for signum, handler in before.items() if handler is not None}
+    for signum in before:
+        signal.signal(signum, lambda number, _frame: record(number))
+    return before
 
 
 def block() -> None:
@@ -89,12 +114,10 @@ def block() -> None:
     handler here all the same (a stopped batch lost its summary to a second SIGTERM)."""
     if OWNED:
         signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
-        if threading.current_thread() is threading.main_thread():
-            for signum in SIGNALS:
-                signal.signal(signum, _record)
+        _hold_handlers(_record)
 
 
-def _record(signum, _frame):
+def _record(signum):
     global RECEIVED
     RECEIVED = RECEIVED or signum
 
