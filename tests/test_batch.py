@@ -105,7 +105,7 @@ def test_scheduler_local_starts_single_threaded_workers_without_dasks_trim_setti
 
     import dask
 
-    from srarap_cli.tasks.batch import _run_on_dask
+    from srarap_cli.tasks.batch_dask import run_on_dask
 
     jobs = [{"name": "twist", "mesh": BAR, "handles": TWIST, "output": "twist.obj"}]
     path = manifest(tmp_path, jobs)
@@ -117,7 +117,7 @@ def test_scheduler_local_starts_single_threaded_workers_without_dasks_trim_setti
     probe = functools.partial(lambda job, out_dir: (
         os.environ.get("MALLOC_TRIM_THRESHOLD_"), os.environ.get("OPENBLAS_NUM_THREADS"),
         dask.config.get("distributed.worker.profile.enabled")), out_dir=str(tmp_path))
-    assert _run_on_dask([{}, {}], probe, "local", 2) == [(None, "1", False)] * 2
+    assert run_on_dask([{}, {}], probe, "local", 2) == [(None, "1", False)] * 2
     assert dask.config.get("distributed.worker.profile.enabled")  # this process: as it was
 
 

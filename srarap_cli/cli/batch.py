@@ -11,13 +11,9 @@ from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..runtime.errors import OutputError
 from ..runtime.signals import Terminated, block
-from ..tasks.batch import (
-    SUMMARY_FIELDS,
-    BatchInterrupted,
-    check_outputs,
-    load_manifest,
-    run_batch,
-)
+from ..tasks.batch import run_batch
+from ..tasks.batch_rows import SUMMARY_FIELDS, BatchInterrupted
+from ..tasks.manifest import check_outputs, load_manifest
 from ..tasks.report import junit_xml, report_html
 from .common import check_output_path, guarded
 

@@ -18,119 +18,27 @@ srarap version).
 import functools
 import hashlib
 import json
-import math
 import os
 import time
 from importlib import metadata
 from typing import Any
 
-from ..io.documents import load_document
 from ..io.handles import load_handles, referenced_files
 from ..io.input_files import read_input_bytes
 from ..io.mesh import format_mesh, read_mesh
-from ..io.mesh.formats import extensions
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
-from ..runtime.environment import environ_changed
-from ..runtime.errors import InputError, NumericalError, SingularSystemError, excerpt
-from ..runtime.paths import refuse_overwriting_inputs
+from ..runtime.errors import InputError, NumericalError, SingularSystemError
 from ..runtime.signals import Terminated
-from ..runtime.threads import worker_processes
-from ..solver.settings import parse_mapping, resolve
+from ..solver.settings import resolve
 from ..solver.stop import StopReason
+from .batch_dask import run_on_dask
+from .batch_rows import BatchInterrupted, Job, Row, interrupted_row, lost_row
 from .compare import beyond, compare_meshes
 from .job_pictures import difference_picture, energy_picture, shape_picture
 from .pipeline import deform_mesh
 from .report import EXIT_CODES, encode_png
-from .worker_pool import WORKER_START, PoolStopped, death_note, run_in_processes
-
-JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
-#: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason` (empty for a job that
-#: never reached the solver)
-#: a job of a manifest: name, absolute paths, output, settings, expect
-Job = dict[str, Any]
-#: a job's summary row (keys SUMMARY_FIELDS)
-Row = dict[str, Any]
-SUMMARY_FIELDS = ("job", "status", "stop", "iterations", "energy", "seconds", "compare_max",
-                  "message", "compare_mean", "tol", "exit_code")
-
-
-def load_manifest(path: str) -> list[Job]:
-    """Jobs of a manifest, with absolute paths and merged settings (list of dict)."""
-    doc = load_document(path, "json" if path.lower().endswith(".json") else "yaml")
-    if not isinstance(doc, dict) or not isinstance(doc.get("jobs"), list) or not doc["jobs"]:
-        raise InputError(f"{path}: a manifest needs a non-empty 'jobs' list")
-    base = os.path.dirname(os.path.abspath(path))
-    defaults = _settings(path, "defaults", doc.get("defaults", {}))
-    jobs, names, outputs = [], set(), set()
-    for k, job in enumerate(doc["jobs"]):
-        where = f"{path}: job {k}"
-        if not isinstance(job, dict) or not {"mesh", "handles", "output"} <= set(job):
-            raise InputError(f"{where}: needs mesh, handles and output")
-        unknown = sorted(set(job) - set(JOB_KEYS))
-        if unknown:
-            raise InputError(f"{where}: unknown key {unknown[0]!r}")
-        output = _output_name(where, job["output"])
-        if output in outputs:
-            raise InputError(f"{where}: output {output!r} is also another job's output")
-        outputs.add(output)
-        name = str(job.get("name", os.path.splitext(output)[0]))
-        if name in names:
-            raise InputError(f"{where}: job name {name!r} used twice")
-        names.add(name)
-        expect = job.get("expect")
-        if expect is not None:
-            if not isinstance(expect, dict) or "golden" not in expect:
-                raise InputError(f"{where}: expect needs a golden mesh")
-            tol = expect.get("tol", 0.0)
-            if isinstance(tol, bool) or not isinstance(tol, (int, float)) \
-                    or not math.isfinite(tol) or tol < 0:
-                raise InputError(f"{where}: expect: tol must be a finite number >= 0")
-            expect = {"golden": os.path.join(base, str(expect["golden"])),
-                      "tol": float(tol),
-                      "relative": bool(expect.get("relative", False))}
-        jobs.append({"name": name, "mesh": os.path.join(base, str(job["mesh"])),
-                     "handles": os.path.join(base, str(job["handles"])),
-                     "output": output, "expect": expect,
-                     "settings": {**defaults, **_settings(where, "settings",
-                                                          job.get("settings", {}))}})
-    return jobs
-
-
-def _output_name(where, value):
-    """A job's output as a relative path inside the output folder, with a mesh extension."""
-    if not isinstance(value, str) or not value:
-        raise InputError(f"{where}: output must be a file name")
-    norm = os.path.normpath(value)
-    if os.path.isabs(value) or norm == ".." or norm.startswith(".." + os.sep):
-        raise InputError(f"{where}: output {excerpt(value)!r} must stay inside the output "
-                         "folder (-o): no absolute path, no '..'")
-    if os.path.splitext(norm)[1].lower() not in extensions():
-        raise InputError(f"{where}: output {excerpt(value)!r} needs one of the extensions "
-                         f"{', '.join(extensions())}")
-    return norm
-
-
-def check_outputs(jobs: list[Job],
-                  out_dir: str, manifest: str) -> None:
-    """Refuse a run whose outputs (or their sidecars) would land on any job's input or the
-    manifest: a batch must never overwrite what it reads."""
-    inputs = [("manifest", manifest)]
-    for job in jobs:
-        inputs += [(f"mesh of job {job['name']!r}", job["mesh"]),
-                   (f"handle file of job {job['name']!r}", job["handles"]),
-                   *((f"file named by job {job['name']!r}'s handles", path)
-                     for path in referenced_files(job["handles"])),
-                   *([(f"golden mesh of job {job['name']!r}", job["expect"]["golden"])]
-                     if job["expect"] else [])]
-    outputs = [os.path.join(out_dir, name) for job in jobs
-               for name in (job["output"], job["output"] + ".srarap.json")]
-    outputs += [os.path.join(out_dir, name) for name in ("summary.csv", "summary.json")]
-    refuse_overwriting_inputs(outputs, inputs)
-
-
-def _settings(where, key, spec):
-    return parse_mapping(spec, key, lambda message: InputError(f"{where}: {message}"))
+from .worker_pool import PoolStopped, run_in_processes
 
 
 def fingerprint(job: Job) -> str:
@@ -295,7 +203,7 @@ def run_batch(jobs: list[Job],
     run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged,
                             pictures=pictures)
     if scheduler is not None:
-        return _run_on_dask(jobs, run, scheduler, workers)
+        return run_on_dask(jobs, run, scheduler, workers)
     if workers <= 1:
         rows: list[Row] = []
         try:
@@ -308,158 +216,13 @@ def run_batch(jobs: list[Job],
     return _run_in_processes(jobs, run, workers)
 
 
-class BatchInterrupted(BaseException):
-    """SIGINT or SIGTERM stopped a batch: ``rows`` are the summary rows, in manifest order,
-    of the jobs that finished and of the others (``status`` ``interrupted``); ``signal`` the
-    exception the signal raised."""
-
-    def __init__(self, rows: list[Row], signal: BaseException) -> None:
-        super().__init__("interrupted")
-        self.rows, self.signal = rows, signal
-
-
-def interrupted_row(job: Job) -> Row:
-    """The summary row of a job a signal stopped before it finished."""
-    return {"job": job["name"], "status": "interrupted", "stop": "", "iterations": None,
-            "energy": None, "seconds": None, "compare_max": None,
-            "message": "not finished: the batch was interrupted", "compare_mean": None,
-            "tol": None, "exit_code": EXIT_CODES["interrupted"]}
-
-
 def _run_in_processes(jobs, run, workers):
     """Jobs in ``workers`` processes (:mod:`.worker_pool`), rows in manifest order; a signal
     raises :class:`BatchInterrupted` with the rows of the jobs that finished."""
     try:
-        return run_in_processes(jobs, run, workers, _lost_row)
+        return run_in_processes(jobs, run, workers, lost_row)
     except PoolStopped as exc:
         raise BatchInterrupted([exc.rows.get(k) or interrupted_row(job)
                                 for k, job in enumerate(jobs)], exc.signal) from None
 
 
-def _lost_row(job, exitcode):
-    """The summary row of a job whose worker process died when it ran alone."""
-    return _unfinished_row(job, death_note(exitcode),
-                           128 - exitcode if exitcode < 0 else exitcode or 1)
-
-
-def _unfinished_row(job, reason, exit_code):
-    """The summary row of a job that failed without a row of its own (its process died)."""
-    return {**interrupted_row(job), "status": "failed", "exit_code": exit_code,
-            "message": f"not finished: {reason}"}
-
-
-#: what srarap's own Dask workers get instead of Dask's defaults: one BLAS thread, and glibc's
-#: dynamic malloc trimming (Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536, which turned each
-#: solve's large temporaries into mmap/munmap pairs: system time 0.23 -> 4.5 s for 20 jobs)
-WORKER_ENVIRON = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1}
-#: Dask settings for the workers srarap starts. They come from a fork server that imported
-#: the jobs' code once: a spawned worker imports numpy, scipy, libigl and distributed again
-#: (about 1.5 s for two), which made 20 jobs of 5k vertices take 4.7 s against 3.2 s with
-#: --workers 2; forked from the batch itself they started at once, but beside the cluster's
-#: threads (see :func:`..runtime.threads.worker_processes`). The rest wakes the workers less
-#: often:
-#: Dask's profiler samples the running task's stack every 10 ms (for a dashboard these
-#: clusters do not have), event loops tick every 20 ms, monitors poll psutil 10 times a
-#: second; on 2 cores each wake-up takes the core from a solve. With Dask's defaults a job
-#: used 5.6% more CPU time in its thread than in a --workers 2 process; with these settings, 1%.
-LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRON,
-                "distributed.worker.profile.enabled": False,
-                "distributed.admin.tick.interval": "1s",
-                "distributed.admin.system-monitor.interval": "5s",
-                "distributed.worker.memory.monitor-interval": "1s",
-                # one task per worker at a time: the death of a worker then counts against
-                # the task it ran only (Dask's 1.1 queued a second one there, which failed
-                # with it), and a task whose worker died runs once more, then fails (Dask's
-                # default, 3 more times, ran a job too large for the machine into its limit
-                # 4 times)
-                "distributed.scheduler.worker-saturation": 1.0,
-                "distributed.scheduler.allowed-failures": 1}
-
-
-def _run_on_dask(jobs, run, scheduler, workers):
-    """On the cluster at ``scheduler``, or on a local one of ``workers`` single-threaded
-    worker processes when ``scheduler`` is ``local``."""
-    try:
-        import dask
-        from distributed import LocalCluster
-    except ImportError:
-        raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
-    run = functools.partial(run, out_dir=os.path.abspath(run.keywords["out_dir"]))
-    if scheduler != "local":
-        return _gather_at(scheduler, jobs, run, scheduler)
-    # the cluster runs threads from its start: its workers come from a fork server
-    with _without_dasks_trim_setting(), \
-            worker_processes([WORKER_START, "distributed"], threads_ahead=True) as context:
-        with dask.config.set({**LOCAL_CONFIG, "distributed.worker.multiprocessing-method":
-                              context.get_start_method()}):
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
-        try:
-            return _gather_at(cluster, jobs, run, scheduler)
-        finally:
-            cluster.close()
-
-
-def _gather_at(cluster, jobs, run, scheduler):
-    """The jobs' rows from ``cluster`` (an address or a cluster), which ``--scheduler
-    scheduler`` named."""
-    from distributed import Client
-
-    try:
-        return _gather(Client(cluster, timeout=30), jobs, run)
-    except (OSError, TimeoutError) as exc:
-        raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
-
-
-def _without_dasks_trim_setting():
-    """A Dask nanny started earlier in this process left its MALLOC_TRIM_THRESHOLD_ in
-    ``os.environ``, where new workers would inherit it: hold it back while they spawn."""
-    left = os.environ.get("MALLOC_TRIM_THRESHOLD_") == "65536"
-    return environ_changed({"MALLOC_TRIM_THRESHOLD_": None} if left else {})
-
-
-
-
-def _silence_dask():
-    """Dask's and asyncio's log lines while a cluster is stopped early (cancelled tasks,
-    lost workers, the interrupted gather's tasks collected later) are not the user's
-    concern: the summary says what finished. For the rest of the process, which is ending."""
-    import logging
-    for name in ("distributed", "asyncio"):
-        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
-
-
-def _gather(client, jobs, run):
-    """The rows of ``jobs`` run on ``client``'s cluster. A job Dask gave up on (its worker
-    died each time it ran it: Dask's KilledWorker) is a failed row, not the batch's end."""
-    with client:
-        futures = client.map(run, jobs, pure=False)
-        rows = []
-        try:
-            # one at a time: a finished task whose worker died is computed again, and its
-            # result() waits for that
-            for future, job in zip(futures, jobs):
-                rows.append(_dask_row(future, job))
-        except (KeyboardInterrupt, Terminated) as exc:
-            _silence_dask()
-            rows = [f.result() if f.status == "finished" else interrupted_row(job)
-                    for f, job in zip(futures, jobs)]
-            client.cancel(futures)
-            raise BatchInterrupted(rows, exc) from None
-        return rows
-
-
-def _dask_row(future, job):
-    """The job's row from its task; a failed row when the task ended without one
-    (``run_job`` itself never raises: its worker died, or the cluster lost it)."""
-    import asyncio
-
-    try:
-        return future.result()
-    except (Exception, asyncio.CancelledError) as exc:
-        if type(exc).__name__ == "KilledWorker":
-            reason = ("its worker process died each time Dask ran it (the system may have "
-                      "run out of memory)")
-        else:
-            reason = f"Dask: {type(exc).__name__}: {(str(exc).splitlines() or [''])[0][:200]}"
-        return _unfinished_row(job, reason, 1)

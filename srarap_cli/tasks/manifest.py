@@ -1,0 +1,92 @@
+"""A batch manifest: its jobs, with absolute paths and merged settings, and the check that no
+output lands on what a job reads (see :mod:`.batch` for the format)."""
+import math
+import os
+
+from ..io.documents import load_document
+from ..io.handles import referenced_files
+from ..io.mesh.formats import extensions
+from ..runtime.errors import InputError, excerpt
+from ..runtime.paths import refuse_overwriting_inputs
+from ..solver.settings import parse_mapping
+from .batch_rows import Job
+
+JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
+
+
+def load_manifest(path: str) -> list[Job]:
+    """Jobs of a manifest, with absolute paths and merged settings (list of dict)."""
+    doc = load_document(path, "json" if path.lower().endswith(".json") else "yaml")
+    if not isinstance(doc, dict) or not isinstance(doc.get("jobs"), list) or not doc["jobs"]:
+        raise InputError(f"{path}: a manifest needs a non-empty 'jobs' list")
+    base = os.path.dirname(os.path.abspath(path))
+    defaults = _settings(path, "defaults", doc.get("defaults", {}))
+    jobs, names, outputs = [], set(), set()
+    for k, job in enumerate(doc["jobs"]):
+        where = f"{path}: job {k}"
+        if not isinstance(job, dict) or not {"mesh", "handles", "output"} <= set(job):
+            raise InputError(f"{where}: needs mesh, handles and output")
+        unknown = sorted(set(job) - set(JOB_KEYS))
+        if unknown:
+            raise InputError(f"{where}: unknown key {unknown[0]!r}")
+        output = _output_name(where, job["output"])
+        if output in outputs:
+            raise InputError(f"{where}: output {output!r} is also another job's output")
+        outputs.add(output)
+        name = str(job.get("name", os.path.splitext(output)[0]))
+        if name in names:
+            raise InputError(f"{where}: job name {name!r} used twice")
+        names.add(name)
+        expect = job.get("expect")
+        if expect is not None:
+            if not isinstance(expect, dict) or "golden" not in expect:
+                raise InputError(f"{where}: expect needs a golden mesh")
+            tol = expect.get("tol", 0.0)
+            if isinstance(tol, bool) or not isinstance(tol, (int, float)) \
+                    or not math.isfinite(tol) or tol < 0:
+                raise InputError(f"{where}: expect: tol must be a finite number >= 0")
+            expect = {"golden": os.path.join(base, str(expect["golden"])),
+                      "tol": float(tol),
+                      "relative": bool(expect.get("relative", False))}
+        jobs.append({"name": name, "mesh": os.path.join(base, str(job["mesh"])),
+                     "handles": os.path.join(base, str(job["handles"])),
+                     "output": output, "expect": expect,
+                     "settings": {**defaults, **_settings(where, "settings",
+                                                          job.get("settings", {}))}})
+    return jobs
+
+
+def _output_name(where, value):
+    """A job's output as a relative path inside the output folder, with a mesh extension."""
+    if not isinstance(value, str) or not value:
+        raise InputError(f"{where}: output must be a file name")
+    norm = os.path.normpath(value)
+    if os.path.isabs(value) or norm == ".." or norm.startswith(".." + os.sep):
+        raise InputError(f"{where}: output {excerpt(value)!r} must stay inside the output "
+                         "folder (-o): no absolute path, no '..'")
+    if os.path.splitext(norm)[1].lower() not in extensions():
+        raise InputError(f"{where}: output {excerpt(value)!r} needs one of the extensions "
+                         f"{', '.join(extensions())}")
+    return norm
+
+
+def check_outputs(jobs: list[Job],
+                  out_dir: str, manifest: str) -> None:
+    """Refuse a run whose outputs (or their sidecars) would land on any job's input or the
+    manifest: a batch must never overwrite what it reads."""
+    inputs = [("manifest", manifest)]
+    for job in jobs:
+        inputs += [(f"mesh of job {job['name']!r}", job["mesh"]),
+                   (f"handle file of job {job['name']!r}", job["handles"]),
+                   *((f"file named by job {job['name']!r}'s handles", path)
+                     for path in referenced_files(job["handles"])),
+                   *([(f"golden mesh of job {job['name']!r}", job["expect"]["golden"])]
+                     if job["expect"] else [])]
+    outputs = [os.path.join(out_dir, name) for job in jobs
+               for name in (job["output"], job["output"] + ".srarap.json")]
+    outputs += [os.path.join(out_dir, name) for name in ("summary.csv", "summary.json")]
+    refuse_overwriting_inputs(outputs, inputs)
+
+
+def _settings(where, key, spec):
+    return parse_mapping(spec, key, lambda message: InputError(f"{where}: {message}"))
