@@ -61,8 +61,24 @@ def test_the_figures_are_what_srarap_draws_today(tmp_path):
                     str(tmp_path)], check=True, capture_output=True)
     assert all((tmp_path / name).is_file() for name in FIGURES)
     stale = [name for name in sorted(set(FIGURES) - TIMED)
-             if (tmp_path / name).read_bytes() != Path(ROOT, "docs", "images", name).read_bytes()]
+             if not _same_picture(tmp_path / name, Path(ROOT, "docs", "images", name))]
     assert not stale, f"regenerate with python docs/make_figures.py: {stale}"
+
+
+def _same_picture(a, b):
+    """The same bytes, or pixels that differ only by round-off in the shading: a colour map
+    of per-vertex values moves a few pixels by a level or two from one machine's BLAS to
+    another's; a stale figure (another shape, view, colour or label) moves thousands."""
+    if a.read_bytes() == b.read_bytes():
+        return True
+    import matplotlib.image as mpimg
+    import numpy as np
+
+    pa, pb = mpimg.imread(a), mpimg.imread(b)
+    if pa.shape != pb.shape:
+        return False
+    d = np.abs(pa - pb).max(axis=-1)
+    return (d > 0).mean() < 1e-3 and d.max() <= 8 / 255
 
 
 def test_a_browser_opens_every_page_without_errors_or_broken_images(site, tmp_path):

@@ -70,8 +70,8 @@ def test_binary_stl_through_a_real_pipe(files):
 
 @pytest.mark.parametrize("data, message", [
     (b"", "standard input is empty"),
-    (b"hello world\n" * 10, "cannot tell the mesh format from its content; give "
-                            "--input-format obj|off|ply|stl"),
+    (b"hello world\n" * 10, "<stdin>: not a mesh: it is text of no mesh format"),
+    (b"hello world\n" * 10, "give --input-format obj|off|ply|stl"),
 ])
 def test_unknown_content_on_standard_input_is_one_clear_line(data, message):
     r = _deform("-", TWIST, "-o", "-", stdin=data)

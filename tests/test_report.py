@@ -15,6 +15,7 @@ from click.testing import CliRunner
 from helpers import ROOT
 
 from srarap_cli.cli import main
+from srarap_cli.tasks.job_status import JobResult, JobStatus
 from srarap_cli.tasks.report import junit_xml, report_html
 
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
@@ -99,7 +100,8 @@ def test_two_runs_on_identical_inputs_differ_only_in_the_seconds(tmp_path):
 # Jenkins' xUnit plugin schema junit-10.xsd, as rules (GitLab, GitHub's test reporters and
 # Buildkite read the same elements): testsuites > testsuite (name, tests, failures and errors
 # required; time a decimal) > testcase (name required) > at most failure / error / skipped /
-# system-out / system-err, each with only type and message attributes.
+# system-out / system-err, each with only type and message attributes; a testsuite may hold
+# properties (each property with exactly name and value).
 SUITE_REQUIRED = {"name", "tests", "failures", "errors"}
 SUITE_ALLOWED = SUITE_REQUIRED | {"group", "time", "skipped", "timestamp", "hostname", "id",
                                   "package", "file", "log", "url"}
@@ -117,8 +119,11 @@ def check_junit(text):
         assert suite.tag == "testsuite"
         assert SUITE_REQUIRED <= set(suite.attrib) <= SUITE_ALLOWED
         assert TIME.fullmatch(suite.get("time", ""))
-        cases = list(suite)
-        assert all(c.tag == "testcase" for c in cases)
+        assert all(c.tag in ("testcase", "properties", "system-out", "system-err")
+                   for c in suite)
+        for prop in suite.iter("property"):
+            assert set(prop.attrib) == {"name", "value"}
+        cases = suite.findall("testcase")
         for case in cases:
             assert "name" in case.attrib and set(case.attrib) <= CASE_ALLOWED
             for outcome in case:
@@ -138,21 +143,26 @@ def test_junit_has_one_case_per_job_with_the_outcome_ci_systems_expect(run):
     cases = {c.get("name"): c for c in root.iter("testcase")}
     assert set(cases) == {"twist-regressed", "bend-ok", "broken"}
     failure = cases["twist-regressed"].find("failure")
+    # the text in the body too: GitLab and Jenkins show the body, not the attribute
     assert failure is not None and "tol 1e-06" in failure.get("message")
-    assert cases["broken"].find("error") is not None
+    assert "tol 1e-06" in failure.text and "beyond tol" in failure.text
+    error = cases["broken"].find("error")
+    assert error is not None and "missing.obj" in error.text
     assert len(cases["bend-ok"]) == 0
-    # a second run: the unchanged jobs are up to date, reported as skipped
+    # a second run: the unchanged jobs are up to date: passed, and said not solved again
     batch(path, tmp / "out")
     root = check_junit((tmp / "out" / "junit.xml").read_text())
     cases = {c.get("name"): c for c in root.iter("testcase")}
-    assert cases["bend-ok"].find("skipped") is not None
+    assert len(cases["bend-ok"]) == 0 and root.find(".//skipped") is None
+    props = {p.get("name"): p.get("value") for p in root.iter("property")}
+    assert props["bend-ok.solved"] == "false" and props["bend-ok.warnings"] == "0"
     html = (tmp / "out" / "report.html").read_text()
     ok = dict(sections(html))["bend-ok"]
     assert "up-to-date" in ok and "data:image/png" in ok  # drawn from its files
 
 
 def test_the_schema_rules_catch_what_ci_systems_refuse():
-    good = junit_xml([{"job": "a", "status": "ok", "seconds": 1.0, "message": ""}], "s")
+    good = junit_xml([JobResult("a", JobStatus.OK, 0, seconds=1.0)], "s")
     check_junit(good)
     with pytest.raises(AssertionError):
         check_junit(good.replace(' failures="0"', "", 1).replace(' failures="0"', ""))
@@ -190,11 +200,11 @@ def test_a_report_of_100_jobs_stays_small_and_opens_in_a_browser(run, tmp_path):
     one = dict(sections(html))["twist-regressed"]
     pictures = dict(zip(("shape", "difference", "energy"),
                         re.findall(r'src="data:image/png;base64,([^"]+)"', one)))
-    rows = [{"job": f"job-{k:03d}", "status": "regressed" if k % 10 == 0 else "ok",
-             "exit_code": None, "stop": "converged", "iterations": 10, "seconds": 0.5,
-             "energy": 1.0, "compare_max": 1e-3, "compare_mean": 1e-4, "tol": 1e-6,
-             "message": ""} for k in range(100)]
-    page = report_html(rows, {r["job"]: pictures for r in rows}, "100 jobs")
+    rows = [JobResult(f"job-{k:03d}", JobStatus.REGRESSED if k % 10 == 0 else JobStatus.OK,
+                      7 if k % 10 == 0 else 0, stop="converged", iterations=10, seconds=0.5,
+                      energy=1.0, compare_max=1e-3, compare_mean=1e-4, tol=1e-6)
+            for k in range(100)]
+    page = report_html(rows, {r.job: pictures for r in rows}, "100 jobs")
     report = tmp_path / "report.html"
     report.write_text(page)
     assert len(page) < 20e6
@@ -208,6 +218,6 @@ def test_a_report_of_100_jobs_stays_small_and_opens_in_a_browser(run, tmp_path):
 
 
 def test_a_picture_that_cannot_be_drawn_is_said_in_the_report_not_hidden():
-    row = {"job": "j", "status": "ok", "seconds": 1.0, "message": ""}
+    row = JobResult("j", JobStatus.OK, 0, seconds=1.0)
     page = report_html([row], {"j": {"note": "pictures not drawn: ValueError: bad mesh"}}, "t")
     assert "pictures not drawn: ValueError: bad mesh" in page and "<img" not in page

@@ -20,15 +20,8 @@ from ..runtime.limits import check_solve
 from ..solver.settings import resolve
 from ..solver.stop import StopReason
 from ..tasks.animation import FRAME_FIELDS, Animator, FrameState, fingerprint
-from .common import (
-    cache_option,
-    check_output_path,
-    finite_option,
-    guarded,
-    refuse_overwrite,
-    report,
-    with_verbosity,
-)
+from ..tasks.preflight import check_output_path, refuse_overwrite
+from .common import cache_option, finite_option, guarded, report, with_verbosity
 from .options import settings_options
 
 STATE_NAME = ".srarap-animate-state.npz"

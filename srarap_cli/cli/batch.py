@@ -12,10 +12,12 @@ from ..runtime.commit import commit_files
 from ..runtime.errors import OutputError
 from ..runtime.signals import Terminated, block
 from ..tasks.batch import run_batch
-from ..tasks.batch_rows import SUMMARY_FIELDS, BatchInterrupted
+from ..tasks.batch_rows import BatchInterrupted
+from ..tasks.job_status import SUMMARY_FIELDS, WARNING_JOIN, JobStatus
 from ..tasks.manifest import check_outputs, load_manifest
+from ..tasks.preflight import check_output_path
 from ..tasks.report import junit_xml, report_html
-from .common import check_output_path, guarded
+from .common import guarded
 
 #: a Dask scheduler address: protocol://host:port, or host:port
 SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
@@ -70,40 +72,67 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         # the summary is what is left to do: a second Ctrl-C or SIGTERM (a CI runner's
         # timeout sends more than one) must not cost it; the exit code says stopped anyway
         block()
-    pictures = {r["job"]: r.pop("pictures", {}) for r in rows}
-    files = [(os.path.join(out, "summary.csv"), _csv(rows).encode()),
-             (os.path.join(out, "summary.json"), (json.dumps(rows, indent=2) + "\n").encode())]
+    pictures = {r.job: r.pictures for r in rows}
+    summary_rows = [r.row() for r in rows]
+    files = [(os.path.join(out, "summary.csv"), _csv(summary_rows).encode()),
+             (os.path.join(out, "summary.json"),
+              (json.dumps(summary_rows, indent=2) + "\n").encode())]
     title = os.path.splitext(os.path.basename(manifest))[0]
     if report is not None:
         files.append((report, report_html(rows, pictures, f"srarap batch: {title}").encode()))
     if junit is not None:
         files.append((junit, junit_xml(rows, title).encode()))
     commit_files(files)
-    counts = {s: sum(r["status"] == s for r in rows) for s in
-              ("ok", "up-to-date", "not-converged", "regressed", "failed", "interrupted")}
-    if not quiet or stopped is not None:
-        for r in rows if not quiet else ():
-            extra = f"  {r['message']}" if r["message"] else ""
-            seconds = "" if r["seconds"] is None else f"{r['seconds']:8.2f} s"
-            click.echo(f"{r['job']:24} {r['status']:13} {seconds:>10}{extra}", err=True)
-        summary = ", ".join(f"{v} {k}" for k, v in counts.items() if v)
-        note = " (nothing to solve: all up to date)" if counts["up-to-date"] == len(rows) else ""
-        if stopped is not None:
-            word = "terminated" if isinstance(stopped, Terminated) else "interrupted"
-            note = (f"; {word}: the jobs not finished are marked interrupted in "
-                    f"{os.path.join(out, 'summary.csv')}")
-        click.echo(f"srarap batch: {len(rows)} jobs: {summary}{note}", err=True)
+    _tell(rows, out, quiet, stopped)
     if stopped is not None:
         raise SystemExit(exit_codes.TERMINATED if isinstance(stopped, Terminated)
                          else exit_codes.INTERRUPTED)
-    if counts["failed"] or counts["regressed"]:
+    if any(r.status in (JobStatus.FAILED, JobStatus.REGRESSED) for r in rows):
         raise SystemExit(exit_codes.BATCH_FAILED)
-    if counts["not-converged"]:
+    if any(r.status is JobStatus.NOT_CONVERGED for r in rows):
         raise SystemExit(exit_codes.NOT_CONVERGED)
+
+
+def _tell(rows, out, quiet, stopped):
+    """The console table (one line a job: its status, seconds, warnings and message, the
+    name printed escaped) and the summary line."""
+    counts = {s: sum(r.status is s for r in rows) for s in JobStatus}
+    if quiet and stopped is None:
+        return
+    for r in rows if not quiet else ():
+        warned = f"  {len(r.warnings)} warning(s)" if r.warnings else ""
+        extra = f"  {printable(r.message)}" if r.message else ""
+        seconds = "" if r.seconds is None else f"{r.seconds:8.2f} s"
+        click.echo(f"{printable(r.job):24} {r.status.value:13} {seconds:>10}{warned}{extra}",
+                   err=True)
+    summary = ", ".join(f"{v} {k.value}" for k, v in counts.items() if v)
+    warned = sum(bool(r.warnings) for r in rows)
+    if warned:
+        summary += f" ({warned} with warnings: see the summary's warnings column)"
+    note = (" (nothing to solve: all up to date)"
+            if counts[JobStatus.UP_TO_DATE] == len(rows) else "")
+    if stopped is not None:
+        word = "terminated" if isinstance(stopped, Terminated) else "interrupted"
+        note = (f"; {word}: the jobs not finished are marked interrupted in "
+                f"{os.path.join(out, 'summary.csv')}")
+    click.echo(f"srarap batch: {len(rows)} jobs: {summary}{note}", err=True)
+
+
+def printable(text: str) -> str:
+    """``text`` for one line of a terminal: control characters (an ESC sequence, a newline)
+    written out, so a job's name can neither colour the terminal nor break the table.
+
+    Examples
+    --------
+    >>> printable("bar\x1b[31m\nred")
+    'bar\\x1b[31m\\nred'
+    """
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
 
 def _csv(rows):
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=SUMMARY_FIELDS, lineterminator="\n")
     w.writeheader()
-    w.writerows(rows)
+    w.writerows({**r, "warnings": WARNING_JOIN.join(r["warnings"])} for r in rows)
     return buf.getvalue()

@@ -13,7 +13,8 @@ from ..solver.settings import resolve
 from ..tasks.bench import ALL_METHODS, IGL, run_methods
 from ..tasks.bench_report import curves_csv, plot_png, summary_json, table
 from ..tasks.pipeline import problem
-from .common import guarded, refuse_overwrite
+from ..tasks.preflight import refuse_overwrite
+from .common import guarded
 from .options import settings_options
 
 CHOICES = ALL_METHODS + (IGL,)

@@ -1,5 +1,4 @@
 """What every subcommand shares: error-to-exit-code mapping and output preflight."""
-import dataclasses
 import functools
 import math
 import os
@@ -12,17 +11,12 @@ from typing import Any, NoReturn
 import click
 import numpy as np
 
-from ..io.handles import Constraints, load_handles, referenced_files
-from ..io.mesh import FORMATS, MeshFormat, read_mesh
-from ..io.mesh.formats import by_extension
-from ..io.mesh.mesh import Mesh
-from ..io.mesh.stream import read_mesh_stream
+from ..io.mesh import FORMATS, MeshFormat
 from ..runtime import exit_codes, signals, streams
 from ..runtime.clock import elapsed
 from ..runtime.commit import COMMITTED
-from ..runtime.errors import InputError, NumericalError, OutputError, SingularSystemError
-from ..runtime.limits import is_out_of_memory, memory_note
-from ..runtime.paths import refuse_overwriting_inputs
+from ..runtime.errors import OutputError
+from ..runtime.failures import classify
 from ..runtime.signals import Terminated
 from ..solver.deformer import DeformResult
 
@@ -72,7 +66,7 @@ def guarded(func: Callable[..., None]) -> Callable[..., None]:
         except Exception as exc:  # noqa: BLE001
             if debug:
                 traceback.print_exc()
-            code, text = _classify(exc)
+            code, text = classify(exc, written())
             fail(code, text)
         except KeyboardInterrupt:
             signals.block()
@@ -105,44 +99,6 @@ def written() -> str:
     if len(files) < len(set(COMMITTED)):
         text += "; run it again with --resume to continue"
     return text
-
-
-def _classify(exc):
-    if isinstance(exc, InputError):
-        return exit_codes.INVALID_INPUT, str(exc)
-    if isinstance(exc, MemoryError) or is_out_of_memory(exc):
-        return exit_codes.INVALID_INPUT, (
-            "out of memory: the mesh is too large for the memory this process may use "
-            f"({memory_note()}); {written()}")
-    if isinstance(exc, OutputError):
-        return exit_codes.OUTPUT_ERROR, str(exc)
-    if isinstance(exc, NumericalError):
-        return exit_codes.NUMERICAL_FAILURE, f"{exc}; {written()}"
-    if isinstance(exc, SingularSystemError | np.linalg.LinAlgError):
-        return exit_codes.NUMERICAL_FAILURE, (
-            f"singular system ({exc}): degenerate geometry (coincident or collinear vertices, "
-            f"zero-area triangles) or a part with no constraint; {written()}")
-    return exit_codes.INTERNAL_ERROR, (f"internal error: {type(exc).__name__}: {exc} "
-                                       "(rerun with --debug for the traceback and report it)")
-
-
-def check_output_path(path: str, allowed: Sequence[str] | None, what: str) -> None:
-    """Fail before any work when an output could not be written (``allowed``: its
-    extensions; None when the format is given otherwise). A missing folder is not a failure:
-    every command makes the missing folders of its outputs when it writes them."""
-    ext = os.path.splitext(path)[1].lower()
-    if allowed is not None and ext not in allowed:
-        raise click.UsageError(f"{what} {path!r}: extension must be one of {', '.join(allowed)}")
-    folder = os.path.dirname(os.path.abspath(path))
-    existing = folder
-    while not os.path.exists(existing):  # missing folders are made when the files are written
-        existing = os.path.dirname(existing)
-    if not os.path.isdir(existing):
-        raise OutputError(f"{path}: {existing} is a file, not a folder")
-    if not os.access(existing, os.W_OK):
-        raise OutputError(f"{path}: folder {existing} is not writable")
-    if os.path.isdir(path):
-        raise OutputError(f"{path}: is a folder")
 
 
 def wall_seconds(result: DeformResult) -> float:
@@ -188,31 +144,6 @@ def finite_option(_ctx: click.Context, _param: click.Parameter,
     return value
 
 
-def refuse_overwrite(outputs: Sequence[str | None], *, mesh: str | None = None,
-                     handles: str | None = None,
-                     others: Sequence[tuple[str, str]] = ()) -> None:
-    """Fail (exit 4) before any work when an output is one of the run's inputs: the mesh, the
-    handle file, the files it names, or ``others`` ((what, path) pairs)."""
-    inputs = [("mesh", mesh)] if mesh not in (None, "-") else []
-    if handles is not None:
-        inputs.append(("handle file", handles))
-        inputs += [("file the handle file names", p) for p in referenced_files(handles)]
-    refuse_overwriting_inputs([o for o in outputs if o not in (None, "-")],
-                              inputs + list(others))
-
-
-def read_any_mesh(path: str, input_format: MeshFormat | None = None
-                  ) -> tuple[Mesh, MeshFormat]:
-    """``(mesh, format)``: the file ``path`` (by its extension), or standard input for ``-``
-    (as ``input_format``, a :class:`~srarap_cli.io.mesh.MeshFormat`, or the format its bytes
-    show)."""
-    if path == "-":
-        return read_mesh_stream(sys.stdin.buffer if sys.stdin else None, input_format)
-    fmt = by_extension(path)
-    assert fmt is not None  # read_mesh refuses what no format claims
-    return read_mesh(path), fmt
-
-
 class MeshFormatType(click.ParamType):
     """A registered mesh format's name, as its :class:`~srarap_cli.io.mesh.MeshFormat`;
     the choices are read from the format table when used, so a format registered after
@@ -248,15 +179,6 @@ def pose_options(func: Callable[..., None]) -> Callable[..., None]:
                         callback=finite_option,
                         help="Frames per second, for keyframes given by time (needed with "
                              "--frame unless every key gives its frame).")(func)
-
-
-def load_posed(handles: str, V: np.ndarray, fps: float | None, frame: float) -> Constraints:
-    """The constraints of ``handles`` with keyframed groups at ``frame``. Frame 0 is time 0
-    at any frame rate, so its pose needs no ``--fps`` even where keys give times."""
-    constraints = load_handles(handles, V, fps=fps, any_rate=frame == 0)
-    if frame == 0 or not constraints.tracks:
-        return constraints
-    return dataclasses.replace(constraints, targets=constraints.targets_at(frame))
 
 
 cache_option = click.option("--cache", type=click.Path(file_okay=False),

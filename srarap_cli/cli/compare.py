@@ -8,8 +8,10 @@ from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..tasks.compare import beyond, compare_meshes
 from ..tasks.job_pictures import compare_pictures
+from ..tasks.job_status import JobResult, JobStatus
+from ..tasks.preflight import check_output_path, read_any_mesh, refuse_overwrite
 from ..tasks.report import junit_xml, report_html
-from .common import check_output_path, guarded, input_format_option, read_any_mesh, refuse_overwrite
+from .common import guarded, input_format_option
 
 
 @click.command("compare")
@@ -53,13 +55,13 @@ def compare(a: str, b: str, tol: float, relative: bool, report: str | None,
               "farthest": figures["where"], "beyond_tol": beyond(figures, tol, relative)}
     files = [] if report is None else [(report, (json.dumps(result, indent=2) + "\n").encode())]
     if html_report is not None or junit is not None:
-        row = {"job": f"{a} vs {b}", "status": "ok" if within else "regressed",
-               "seconds": None, "compare_max": shown["max"], "compare_mean": shown["mean"],
-               "tol": tol, "message": "" if within else
-               f"max distance {shown['max']:.3g} > tol {tol:g}{_where(result)}"}
+        status = JobStatus.OK if within else JobStatus.REGRESSED
+        row = JobResult(f"{a} vs {b}", status, status.exit_code, compare_max=shown["max"],
+                        compare_mean=shown["mean"], tol=tol, message="" if within else
+                        f"max distance {shown['max']:.3g} > tol {tol:g}{_where(result)}")
         if html_report is not None:
             pictures = compare_pictures(ma, mb, figures, tol, scale)
-            files.append((html_report, report_html([row], {row["job"]: pictures},
+            files.append((html_report, report_html([row], {row.job: pictures},
                                                    "srarap compare").encode()))
         if junit is not None:
             files.append((junit, junit_xml([row], "compare").encode()))

@@ -1,35 +1,21 @@
 """``srarap deform``: mesh + handle file -> deformed mesh + energy log."""
 import math
-import os
 import sys
 from typing import Any
 
 import click
 
-from ..io.mesh import FORMATS
-from ..io.mesh.formats import MeshFormat, by_extension, extensions
-from ..io.solve_log import LOG_FORMATS, format_log
-from ..runtime import descriptors, exit_codes, memory
-from ..runtime.commit import commit_files
-from ..runtime.errors import OutputError
-from ..runtime.limits import check_solve
+from ..io.mesh.formats import MeshFormat
+from ..runtime import exit_codes, memory
 from ..solver.multires.size import AUTO_THRESHOLD
-from ..solver.settings import resolve
 from ..solver.stop import StopReason
-from ..tasks.distortion import vertex_distortion
-from ..tasks.info import up_axis
-from ..tasks.pipeline import deform_mesh, refuse_warnings
-from ..tasks.preview import preview_png
+from ..tasks.job import DeformJob, JobStatus, run_job
 from .common import (
     MeshFormatType,
     cache_option,
-    check_output_path,
     guarded,
     input_format_option,
-    load_posed,
     pose_options,
-    read_any_mesh,
-    refuse_overwrite,
     report,
     wall_seconds,
     with_verbosity,
@@ -77,91 +63,25 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
     Exit codes: 0 converged, 3 not converged (no mesh written unless --keep-unconverged; the
     log is written), 2 usage, 4 invalid input, 5 numerical failure, 6 output error.
     """
-    fmt = _output_format(out, out_format, mesh)
-    if fmt is not None:
-        _check_format_options(fmt, ascii, write_distortion)
-    if out != "-":  # an extension the table knows, or --format for a name without one
-        check_output_path(out, None if by_extension(out) is None and out_format else extensions(),
-                          "output")
-    elif descriptors.closed(1):
-        raise OutputError("-o -: standard output is closed; name an output file")
-    if preview is not None:
-        check_output_path(preview, (".png",), "preview")
-    if log is not None:
-        check_output_path(log, LOG_FORMATS, "log")
-        if os.path.abspath(log) == os.path.abspath(out):
-            raise click.UsageError("--log and --output name the same file")
-    refuse_overwrite([out, log, preview], mesh=mesh, handles=handles)
     if (verbosity or 0) >= 2:  # -v: peak memory per stage (off otherwise: see runtime.memory)
         memory.enable()
-    peak = memory.start()
-    source, source_format = read_any_mesh(mesh, input_format)
-    peaks = {"read": memory.stop(peak)}
-    if fmt is None:
-        fmt = source_format
-        _check_format_options(fmt, ascii, write_distortion)
-    name = "<stdin>" if mesh == "-" else mesh
-    check_solve(name, len(source.vertices))
-    constraints = load_posed(handles, source.vertices, fps, frame)
-    opts = resolve(constraints.solver, overrides)
+    job = DeformJob(mesh, handles, out, overrides, input_format=input_format,
+                    output_format=out_format, ascii=ascii, write_distortion=write_distortion,
+                    log=log, preview=preview, preview_up=preview_up,
+                    keep_unconverged=keep_unconverged, cache=cache, fps=fps, frame=frame)
     progress = SolveProgress(enabled=verbosity != 0 and sys.stderr.isatty())
-    peak = memory.start()
     try:
-        deformed, result, notes = deform_mesh(source, constraints, opts, callback=progress,
-                                              cache=cache, name=name)
+        done = run_job(job, callback=progress, write_stdout=write_stdout)
     finally:
         progress.close()
-    peaks["solve"], peak = memory.stop(peak), memory.start()
-    if write_distortion:
-        deformed.vertex_data["distortion"] = vertex_distortion(
-            source.vertices, deformed.vertices, source.triangles()[0])
-    done = result.complete
-    mesh_bytes, lost = fmt.encode(deformed, ascii)
-    refuse_warnings(opts, lost)
-    keep = done or keep_unconverged
-    files = [(out, mesh_bytes)] if keep and out != "-" else []
-    if preview is not None and keep:
-        files.append((preview, preview_png(deformed, source, constraints, view="iso",
-                                                  up=up_axis(source) if preview_up == "auto"
-                                                  else preview_up)))
-    if log is not None:
-        files.append((log, format_log(result.log, os.path.splitext(log)[1].lower()).encode()))
-    if keep and out == "-":  # first: the files are committed only once it was written
-        write_stdout(mesh_bytes)
-    commit_files(files)
-    peaks["write"] = memory.stop(peak)
-    shown = "<stdout>" if out == "-" else out
-    measured = memory.gigabytes(peaks)
-    report(verbosity, warnings=notes + lost,
-           details=result.report_lines() + ([f"srarap: peak memory: {measured}"]
-                                             if measured else []),
-           summary=_summary(result, opts, shown if keep else None))
-    if not done:
+    measured = memory.gigabytes(done.peaks)
+    report(verbosity, warnings=done.warnings,
+           details=done.solve.report_lines() + ([f"srarap: peak memory: {measured}"]
+                                                if measured else []),
+           summary=_summary(done.solve, done.settings,
+                            done.written and ("<stdout>" if out == "-" else out)))
+    if done.status is JobStatus.NOT_CONVERGED:
         raise SystemExit(exit_codes.NOT_CONVERGED)
-
-
-def _output_format(out, out_format, mesh):
-    """The output's MeshFormat: ``--format``, or the extension of ``out``; for ``-o -``
-    without ``--format``, the input file's, or None for standard input (its bytes decide)."""
-    if out == "-":
-        return out_format or (None if mesh == "-" else by_extension(mesh))
-    fmt = by_extension(out)
-    if out_format is not None and fmt is not None and fmt is not out_format:
-        raise click.UsageError(f"--format {out_format.name} does not match the output {out!r}")
-    return fmt or out_format
-
-
-def _check_format_options(fmt, ascii, write_distortion):
-    if ascii and not fmt.has_ascii:
-        raise click.UsageError(f"--ascii applies to {_having('has_ascii')} output only")
-    if write_distortion and not fmt.keeps_vertex_data:
-        raise click.UsageError(f"--write-distortion needs a {_having('keeps_vertex_data')} "
-                               "output")
-
-
-def _having(attribute):
-    """The names of the formats with ``attribute`` set, for a message: ``PLY``."""
-    return "/".join(f.name.upper() for f in FORMATS.values() if getattr(f, attribute))
 
 
 def _summary(result, opts, out):

@@ -5,7 +5,8 @@ import click
 
 from ..io.mesh.formats import MeshFormat
 from ..tasks.info import handles_info, mesh_info
-from .common import guarded, input_format_option, load_posed, pose_options, read_any_mesh
+from ..tasks.preflight import load_posed, read_any_mesh
+from .common import guarded, input_format_option, pose_options
 
 
 @click.command("info")

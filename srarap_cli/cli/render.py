@@ -15,9 +15,10 @@ from ..runtime.errors import InputError
 from ..tasks.frames import animated_gif, contact_sheet, frame_pictures, sheet_choice
 from ..tasks.info import up_axis
 from ..tasks.log_axis import decades_axis
+from ..tasks.preflight import check_output_path, read_any_mesh, refuse_overwrite
 from ..tasks.preview import preview_png
 from ..tasks.render import VIEWS
-from .common import check_output_path, guarded, input_format_option, read_any_mesh, refuse_overwrite
+from .common import guarded, input_format_option
 
 
 def parse_size(text: str) -> tuple[int, int]:

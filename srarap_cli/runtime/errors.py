@@ -19,6 +19,11 @@ class SingularSystemError(RuntimeError):
     """A factorization met a singular matrix (for example a part with no constraint)."""
 
 
+class UsageProblem(ValueError):
+    """Options that do not go together (``--ascii`` for a format without a text variant):
+    exit code 2, as the command line's own usage errors."""
+
+
 def unknown_key(key: object, allowed: Iterable[str], where: str) -> str:
     """The message for a key ``where`` does not take, with the nearest allowed key as a hint.
 

@@ -16,112 +16,35 @@ the same fingerprint (content of the mesh, the handle file and every file it nam
 srarap version).
 """
 import functools
-import hashlib
-import json
 import os
 import time
-from importlib import metadata
 from typing import Any
 
-from ..io.handles import load_handles, referenced_files
-from ..io.input_files import read_input_bytes
-from ..io.mesh import format_mesh, read_mesh
-from ..runtime import exit_codes
-from ..runtime.commit import commit_files
-from ..runtime.errors import InputError, NumericalError, SingularSystemError
+from ..io.handles import load_handles
+from ..io.mesh import read_mesh
 from ..runtime.signals import Terminated
-from ..solver.settings import resolve
-from ..solver.stop import StopReason
 from .batch_dask import run_on_dask
-from .batch_rows import BatchInterrupted, Job, Row, interrupted_row, lost_row
-from .compare import beyond, compare_meshes
+from .batch_rows import BatchInterrupted, Job, deform_job, interrupted_row, lost_row
+from .job import JobResult, run_job_safely
 from .job_pictures import difference_picture, energy_picture, shape_picture
-from .pipeline import deform_mesh
-from .report import EXIT_CODES, encode_png
+from .report import encode_png
 from .worker_pool import PoolStopped, run_in_processes
 
 
-def fingerprint(job: Job) -> str:
-    """Content hash of everything that decides a job's output."""
-    h = hashlib.sha256()
-    for path in (job["mesh"], job["handles"], *referenced_files(job["handles"])):
-        try:
-            h.update(hashlib.sha256(read_input_bytes(path)).digest())
-        except InputError:
-            h.update(b"missing:" + path.encode())
-    h.update(json.dumps([job["settings"], job["output"], metadata.version("srarap-cli")],
-                        sort_keys=True).encode())
-    return h.hexdigest()
-
-
 def run_job(job: Job, out_dir: str, keep_unconverged: bool = False,
-            pictures: bool = False) -> Row:
-    """Run one job; never raises. Returns its summary row (dict with SUMMARY_FIELDS; with
-    ``pictures``, also ``pictures``: the report's pictures of the job, see
-    :func:`job_pictures`).
+            pictures: bool = False) -> JobResult:
+    """Run one job of a manifest through the job runner (:func:`.job.run_job_safely`);
+    never raises. With ``pictures``, the result carries the report's pictures of the job
+    (see :func:`job_pictures`).
 
-    A job that does not converge writes its sidecar (the status, so a rerun reports it without
-    solving again) but not its mesh, unless ``keep_unconverged``: as ``srarap deform``."""
-    start = time.perf_counter()
-    row = {"job": job["name"], "status": "failed", "stop": "", "iterations": None,
-           "energy": None, "seconds": None, "compare_max": None, "message": "",
-           "compare_mean": None, "tol": None, "exit_code": None}
-    seen: dict[str, Any] = {}  # what the pictures are drawn from
-    out = os.path.join(out_dir, job["output"])
-    sidecar = out + ".srarap.json"
-    try:
-        key = fingerprint(job)
-        recorded = _recorded_row(sidecar) if _recorded(sidecar) == key else None
-        if recorded is not None and (os.path.exists(out) or (
-                recorded["status"] == "not-converged" and not keep_unconverged)):
-            # an unchanged job that did not converge stays not converged, run after run
-            row.update(recorded, status="up-to-date" if recorded["status"] == "ok" else
-                       recorded["status"])
-            if row["status"] != "up-to-date":
-                row["message"] = "inputs unchanged since the recorded run"
-        else:
-            mesh = read_mesh(job["mesh"])
-            constraints = load_handles(job["handles"], mesh.vertices)
-            opts = resolve(constraints.solver, job["settings"])
-            deformed, result, _ = deform_mesh(mesh, constraints, opts, name=job["mesh"])
-            seen.update(mesh=mesh, deformed=deformed, constraints=constraints, log=result.log)
-            data, _ = format_mesh(deformed, os.path.splitext(out)[1].lower())
-            status = "ok" if result.complete else "not-converged"
-            stop = result.stop_reason.value
-            row.update(status=status, stop=stop, iterations=result.iterations,
-                       energy=result.energy)
-            os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
-            record = json.dumps({"fingerprint": key, "iterations": result.iterations,
-                                 "energy": result.energy, "status": status,
-                                 "stop": stop}).encode()
-            keep = status == "ok" or keep_unconverged
-            commit_files([(out, data)] * keep + [(sidecar, record)])
-            if not keep:
-                row["message"] = "mesh not written (--keep-unconverged writes it)"
-        if job["expect"] is not None and os.path.exists(out) and row["status"] != "not-converged":
-            seen["golden"] = _check_golden(row, job["expect"], out)
-    except Exception as exc:  # noqa: BLE001 -- a failing job is reported, never fatal
-        row.update(status="failed", message=str(exc).splitlines()[0] if str(exc) else
-                   type(exc).__name__, exit_code=_failure_code(exc))
-        if isinstance(exc, NumericalError):
-            row["stop"] = StopReason.NON_FINITE.value
-    if row["exit_code"] is None:
-        row["exit_code"] = EXIT_CODES.get(row["status"])
-    row["seconds"] = time.perf_counter() - start
+    A job that does not converge writes its record (the status, so a rerun reports it
+    without solving again) but not its mesh, unless ``keep_unconverged``: as ``srarap
+    deform``."""
+    spec = deform_job(job, out_dir, keep_unconverged)
+    result = run_job_safely(spec)
     if pictures:  # after the seconds: the solve's, not the drawing's
-        row["pictures"] = job_pictures(job, out, seen)
-    return row
-
-
-def _failure_code(exc):
-    """The exit code ``srarap deform`` gives for the failure ``exc``."""
-    if isinstance(exc, InputError):
-        return exit_codes.INVALID_INPUT
-    if isinstance(exc, (NumericalError, SingularSystemError)):
-        return exit_codes.NUMERICAL_FAILURE
-    if isinstance(exc, OSError):
-        return exit_codes.OUTPUT_ERROR
-    return 1
+        result.pictures = job_pictures(job, spec.output, result.seen)
+    return result.shipped()
 
 
 def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
@@ -156,44 +79,9 @@ def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
     return out_pictures
 
 
-def _check_golden(row, expect, out):
-    """Compare the job's output with its golden mesh into ``row``; returns the figures and
-    ``expect`` (for the report's difference picture)."""
-    figures = compare_meshes(read_mesh(expect["golden"]), read_mesh(out))
-    scale = figures["diagonal"] if expect["relative"] and figures["diagonal"] > 0 else 1.0
-    row.update(compare_max=figures["max"] / scale, compare_mean=figures["mean"] / scale,
-               tol=expect["tol"])
-    if row["compare_max"] > expect["tol"]:
-        row["status"] = "regressed"
-        far = figures["where"]
-        at = "" if far is None else (f" at vertex {far['vertex']} of the "
-                                     f"{'golden' if far['mesh'] == 'a' else 'output'} mesh")
-        row["message"] = (f"max distance {row['compare_max']:.3g} > tol {expect['tol']:g}"
-                          f"{at}; {100 * beyond(figures, expect['tol'], expect['relative']):.3g}"
-                          "% of the vertices beyond tol")
-    return figures, expect
-
-
-def _recorded(sidecar):
-    try:
-        with open(sidecar) as fh:
-            rec = json.load(fh)
-        # a record without a status predates status records: run the job again
-        return rec.get("fingerprint") if "status" in rec else None
-    except (OSError, ValueError):
-        return None
-
-
-def _recorded_row(sidecar):
-    with open(sidecar) as fh:
-        rec = json.load(fh)
-    return {"iterations": rec.get("iterations"), "energy": rec.get("energy"),
-            "status": rec["status"], "stop": rec.get("stop", "")}
-
-
 def run_batch(jobs: list[Job],
               out_dir: str, workers: int = 1, scheduler: str | None = None, keep_unconverged: bool = False,
-              pictures: bool = False) -> list[Row]:
+              pictures: bool = False) -> list[JobResult]:
     """Run jobs: on a Dask cluster at ``scheduler``, else in ``workers`` local processes
     (in this process when 1). Rows come back in manifest order. ``keep_unconverged``: see
     :func:`run_job`.
@@ -202,27 +90,29 @@ def run_batch(jobs: list[Job],
     """
     run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged,
                             pictures=pictures)
+    unfinished = functools.partial(interrupted_row, out_dir=out_dir,
+                                   keep_unconverged=keep_unconverged, since=time.time())
     if scheduler is not None:
-        return run_on_dask(jobs, run, scheduler, workers)
+        return run_on_dask(jobs, run, scheduler, workers, unfinished)
     if workers <= 1:
-        rows: list[Row] = []
+        rows: list[JobResult] = []
         try:
             for job in jobs:
                 rows.append(run(job))
         except (KeyboardInterrupt, Terminated) as exc:
-            raise BatchInterrupted(rows + [interrupted_row(j) for j in jobs[len(rows):]],
+            raise BatchInterrupted(rows + [unfinished(j) for j in jobs[len(rows):]],
                                    exc) from None
         return rows
-    return _run_in_processes(jobs, run, workers)
+    return _run_in_processes(jobs, run, workers, unfinished)
 
 
-def _run_in_processes(jobs, run, workers):
+def _run_in_processes(jobs, run, workers, unfinished):
     """Jobs in ``workers`` processes (:mod:`.worker_pool`), rows in manifest order; a signal
     raises :class:`BatchInterrupted` with the rows of the jobs that finished."""
     try:
         return run_in_processes(jobs, run, workers, lost_row)
     except PoolStopped as exc:
-        raise BatchInterrupted([exc.rows.get(k) or interrupted_row(job)
+        raise BatchInterrupted([exc.rows.get(k) or unfinished(job)
                                 for k, job in enumerate(jobs)], exc.signal) from None
 
 

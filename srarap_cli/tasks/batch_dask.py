@@ -2,12 +2,14 @@
 address; rows in manifest order, a job Dask gave up on a failed row."""
 import functools
 import os
+from collections.abc import Callable
 
 from ..runtime.environment import environ_changed
 from ..runtime.errors import InputError
 from ..runtime.signals import Terminated
 from ..runtime.threads import worker_processes
-from .batch_rows import BatchInterrupted, Job, Row, interrupted_row, unfinished_row
+from .batch_rows import BatchInterrupted, Job, interrupted_row, unfinished_row
+from .job_status import JobResult
 from .worker_pool import WORKER_START
 
 #: what srarap's own Dask workers get instead of Dask's defaults: one BLAS thread, and glibc's
@@ -38,11 +40,13 @@ LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRON,
                 "distributed.scheduler.allowed-failures": 1}
 
 
-def run_on_dask(jobs: list[Job], run: "functools.partial[Row]", scheduler: str,
-                workers: int) -> list[Row]:
-    """The rows of ``jobs`` run by ``run`` (:func:`.batch.run_job` with its keywords bound,
-    ``out_dir`` among them) on the cluster at ``scheduler``, or on a local one of ``workers``
-    single-threaded worker processes when ``scheduler`` is ``local``."""
+def run_on_dask(jobs: list[Job], run: "functools.partial[JobResult]", scheduler: str,
+                workers: int, unfinished: Callable[[Job], JobResult] = interrupted_row
+                ) -> list[JobResult]:
+    """The results of ``jobs`` run by ``run`` (:func:`.batch.run_job` with its keywords
+    bound, ``out_dir`` among them) on the cluster at ``scheduler``, or on a local one of
+    ``workers`` single-threaded worker processes when ``scheduler`` is ``local``;
+    ``unfinished(job)`` is the result of a job a signal stopped."""
     try:
         import dask
         from distributed import LocalCluster
@@ -50,7 +54,7 @@ def run_on_dask(jobs: list[Job], run: "functools.partial[Row]", scheduler: str,
         raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
     run = functools.partial(run, out_dir=os.path.abspath(run.keywords["out_dir"]))
     if scheduler != "local":
-        return _gather_at(scheduler, jobs, run, scheduler)
+        return _gather_at(scheduler, jobs, run, scheduler, unfinished)
     # the cluster runs threads from its start: its workers come from a fork server
     with _without_dasks_trim_setting(), \
             worker_processes([WORKER_START, "distributed"], threads_ahead=True) as context:
@@ -59,18 +63,18 @@ def run_on_dask(jobs: list[Job], run: "functools.partial[Row]", scheduler: str,
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None)
         try:
-            return _gather_at(cluster, jobs, run, scheduler)
+            return _gather_at(cluster, jobs, run, scheduler, unfinished)
         finally:
             cluster.close()
 
 
-def _gather_at(cluster, jobs, run, scheduler):
+def _gather_at(cluster, jobs, run, scheduler, unfinished):
     """The jobs' rows from ``cluster`` (an address or a cluster), which ``--scheduler
     scheduler`` named."""
     from distributed import Client
 
     try:
-        return _gather(Client(cluster, timeout=30), jobs, run)
+        return _gather(Client(cluster, timeout=30), jobs, run, unfinished)
     except (OSError, TimeoutError) as exc:
         raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
 
@@ -91,7 +95,7 @@ def _silence_dask():
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
-def _gather(client, jobs, run):
+def _gather(client, jobs, run, unfinished):
     """The rows of ``jobs`` run on ``client``'s cluster. A job Dask gave up on (its worker
     died each time it ran it: Dask's KilledWorker) is a failed row, not the batch's end."""
     with client:
@@ -104,7 +108,7 @@ def _gather(client, jobs, run):
                 rows.append(_dask_row(future, job))
         except (KeyboardInterrupt, Terminated) as exc:
             _silence_dask()
-            rows = [f.result() if f.status == "finished" else interrupted_row(job)
+            rows = [f.result() if f.status == "finished" else unfinished(job)
                     for f, job in zip(futures, jobs)]
             client.cancel(futures)
             raise BatchInterrupted(rows, exc) from None

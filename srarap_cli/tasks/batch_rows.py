@@ -1,45 +1,62 @@
-"""A batch's summary rows: their fields, the rows of jobs that did not finish (a signal stopped
-the batch, a worker process died), and the interruption that carries them."""
+"""A batch's results of jobs that did not finish (a signal stopped the batch, a worker process
+died), and the interruption that carries every job's result."""
+import os
 from typing import Any
 
-from .report import EXIT_CODES
+from .job import DeformJob, JobResult, JobStatus, recorded_result
+from .job_record import sidecar_path
 from .worker_pool import death_note
 
 #: a job of a manifest: name, absolute paths, output, settings, expect
 Job = dict[str, Any]
-#: a job's summary row (keys SUMMARY_FIELDS)
-Row = dict[str, Any]
-#: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason` (empty for a job that
-#: never reached the solver)
-SUMMARY_FIELDS = ("job", "status", "stop", "iterations", "energy", "seconds", "compare_max",
-                  "message", "compare_mean", "tol", "exit_code")
 
 
 class BatchInterrupted(BaseException):
-    """SIGINT or SIGTERM stopped a batch: ``rows`` are the summary rows, in manifest order,
+    """SIGINT or SIGTERM stopped a batch: ``rows`` are the jobs' results, in manifest order,
     of the jobs that finished and of the others (``status`` ``interrupted``); ``signal`` the
     exception the signal raised."""
 
-    def __init__(self, rows: list[Row], signal: BaseException) -> None:
+    def __init__(self, rows: list[JobResult], signal: BaseException) -> None:
         super().__init__("interrupted")
         self.rows, self.signal = rows, signal
 
 
-def interrupted_row(job: Job) -> Row:
-    """The summary row of a job a signal stopped before it finished."""
-    return {"job": job["name"], "status": "interrupted", "stop": "", "iterations": None,
-            "energy": None, "seconds": None, "compare_max": None,
-            "message": "not finished: the batch was interrupted", "compare_mean": None,
-            "tol": None, "exit_code": EXIT_CODES["interrupted"]}
+def deform_job(job: Job, out_dir: str, keep_unconverged: bool = False) -> DeformJob:
+    """The :class:`~.job.DeformJob` of a manifest's job (see :mod:`.manifest`), writing
+    under ``out_dir`` and keeping its record there."""
+    return DeformJob(job["mesh"], job["handles"], os.path.join(out_dir, job["output"]),
+                     settings=job["settings"], name=job["name"],
+                     keep_unconverged=keep_unconverged, expect=job["expect"], record=True)
 
 
-def lost_row(job: Job, exitcode: int) -> Row:
-    """The summary row of a job whose worker process died when it ran alone."""
+def interrupted_row(job: Job, out_dir: str | None = None, keep_unconverged: bool = False,
+                    since: float | None = None) -> JobResult:
+    """The result of a job a signal stopped before its result came back. Where its record
+    under ``out_dir`` matches its inputs, the files on disk are that run's: the job is
+    reported as the record says (committed after ``since``, the batch's start: finished as
+    the batch was stopped), else ``interrupted``."""
+    spec = None if out_dir is None else deform_job(job, out_dir, keep_unconverged)
+    done = None if spec is None else recorded_result(spec)
+    if spec is not None and done is not None:
+        try:
+            fresh = since is not None and os.path.getmtime(sidecar_path(spec.output)) >= since
+        except OSError:
+            fresh = False
+        if fresh:
+            done.solved, done.message = True, "finished as the batch was stopped"
+            if done.status is JobStatus.UP_TO_DATE:
+                done.status = JobStatus.OK
+        return done
+    return JobResult(job["name"], JobStatus.INTERRUPTED, JobStatus.INTERRUPTED.exit_code,
+                     message="not finished: the batch was interrupted")
+
+
+def lost_row(job: Job, exitcode: int) -> JobResult:
+    """The result of a job whose worker process died when it ran alone."""
     return unfinished_row(job, death_note(exitcode),
-                           128 - exitcode if exitcode < 0 else exitcode or 1)
+                          128 - exitcode if exitcode < 0 else exitcode or 1)
 
 
-def unfinished_row(job: Job, reason: str, exit_code: int) -> Row:
-    """The summary row of a job that failed without a row of its own (its process died)."""
-    return {**interrupted_row(job), "status": "failed", "exit_code": exit_code,
-            "message": f"not finished: {reason}"}
+def unfinished_row(job: Job, reason: str, exit_code: int) -> JobResult:
+    """The result of a job that failed without a result of its own (its process died)."""
+    return JobResult(job["name"], JobStatus.FAILED, exit_code, message=f"not finished: {reason}")

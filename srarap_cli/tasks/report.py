@@ -7,15 +7,12 @@ timestamp or random id: two runs on identical inputs differ only in the seconds 
 import base64
 import html
 import math
+import re
 from collections.abc import Sequence
-from typing import Any
-from xml.sax.saxutils import quoteattr
+from xml.sax.saxutils import escape, quoteattr
 
-#: the order jobs are shown in: what needs a look first
-ATTENTION = ("failed", "regressed", "not-converged", "interrupted", "ok", "up-to-date")
-#: a batch status -> the exit code ``srarap deform`` / ``compare`` gives for the same outcome
-EXIT_CODES = {"ok": 0, "up-to-date": 0, "not-converged": 3, "regressed": 7,
-              "interrupted": 130}
+from .job_status import JobResult, JobStatus
+
 COLOURS = {"failed": "#c62828", "regressed": "#c62828", "not-converged": "#ef6c00",
            "interrupted": "#6d4c41", "ok": "#2e7d32", "up-to-date": "#558b2f"}
 PICTURES = (("shape", "rest (ghosted) and result, handles coloured"),
@@ -38,19 +35,11 @@ figcaption { font-size: 11px; color: #555; max-width: 240px; }
 """
 
 
-def exit_code(row: dict[str, Any]) -> int | None:
-    """The job's outcome as an exit code (a failed job's from its row: 4 input, 5
-    numerical, 6 output, 1 otherwise)."""
-    if row["status"] == "failed":
-        return row.get("exit_code") or 1
-    return EXIT_CODES.get(row["status"])
-
-
-def ordered(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Rows in the order a reviewer needs them: failures and regressions first (manifest
+def ordered(rows: Sequence[JobResult]) -> list[JobResult]:
+    """Results in the order a reviewer needs them: failures and regressions first (manifest
     order within each status)."""
-    rank = {s: k for k, s in enumerate(ATTENTION)}
-    return sorted(rows, key=lambda r: rank.get(r["status"], len(rank)))
+    rank = {s: k for k, s in enumerate(JobStatus)}
+    return sorted(rows, key=lambda r: rank[r.status])
 
 
 def _number(value, fmt):
@@ -64,27 +53,30 @@ def _seconds(value, fmt=".2f"):
 
 
 def _summary(rows):
-    counts = {s: sum(r["status"] == s for r in rows) for s in ATTENTION}
+    counts = {s.value: sum(r.status is s for r in rows) for s in JobStatus}
     parts = ", ".join(f"{n} {s}" for s, n in counts.items() if n)
-    seconds = sum(r["seconds"] or 0.0 for r in rows)
-    compared = [r for r in rows if r.get("compare_max") is not None]
-    worst = max(compared, key=lambda r: r["compare_max"], default=None)
-    far = (f"; the largest distance to a golden mesh: {worst['compare_max']:.3g} "
-           f"({html.escape(worst['job'])})" if worst else "")
-    return (f"<p class=\"summary\"><b>{len(rows)} jobs</b>: {parts}; "
+    seconds = sum(r.seconds or 0.0 for r in rows)
+    compared = [r for r in rows if r.compare_max is not None]
+    worst = max(compared, key=lambda r: r.compare_max, default=None)
+    far = (f"; the largest distance to a golden mesh: {worst.compare_max:.3g} "
+           f"({html.escape(worst.job)})" if worst else "")
+    warned = sum(bool(r.warnings) for r in rows)
+    warned_text = f"; {warned} with warnings" if warned else ""
+    return (f"<p class=\"summary\"><b>{len(rows)} jobs</b>: {parts}{warned_text}; "
             f"{_seconds(seconds, '.1f')} s of solving{far}</p>")
 
 
 def _job(row, pictures):
-    status = row["status"]
-    numbers = [("exit code", _number(exit_code(row), "d")),
-               ("stop", row.get("stop") or "-"),
-               ("iterations", _number(row.get("iterations"), "d")),
-               ("seconds", _seconds(row.get("seconds"))),
-               ("energy", _number(row.get("energy"), ".6g")),
-               ("to golden: max", _number(row.get("compare_max"), ".3g")),
-               ("mean", _number(row.get("compare_mean"), ".3g")),
-               ("tolerance", _number(row.get("tol"), "g"))]
+    status = row.status.value
+    numbers = [("exit code", _number(row.exit_code, "d")),
+               ("stop", row.stop or "-"),
+               ("iterations", _number(row.iterations, "d")),
+               ("seconds", _seconds(row.seconds)),
+               ("energy", _number(row.energy, ".6g")),
+               ("to golden: max", _number(row.compare_max, ".3g")),
+               ("mean", _number(row.compare_mean, ".3g")),
+               ("tolerance", _number(row.tol, "g")),
+               ("warnings", str(len(row.warnings)))]
     table = ("<tr>" + "".join(f"<th>{k}</th>" for k, _ in numbers) + "</tr><tr>"
              + "".join(f"<td>{v}</td>" for _, v in numbers) + "</tr>")
     figures = "".join(
@@ -92,25 +84,28 @@ def _job(row, pictures):
         f"{pictures[key]}\"><figcaption>{html.escape(caption)}</figcaption></figure>"
         for key, caption in PICTURES if key in pictures)
     message = "".join(f"<p class=\"message\">{html.escape(text)}</p>"
-                      for text in (row.get("message"), pictures.get("note")) if text)
-    return (f"<section class=\"job\" id=\"{html.escape(row['job'], quote=True)}\"><h2>"
-            f"{html.escape(row['job'])} <span class=\"badge\" style=\"background:"
+                      for text in (row.message, pictures.get("note")) if text)
+    warnings = ("<ul class=\"warnings\">" + "".join(
+        f"<li>warning: {html.escape(w)}</li>" for w in row.warnings) + "</ul>"
+        if row.warnings else "")
+    return (f"<section class=\"job\" id=\"{html.escape(row.job, quote=True)}\"><h2>"
+            f"{html.escape(row.job)} <span class=\"badge\" style=\"background:"
             f"{COLOURS.get(status, '#555')}\">{html.escape(status)}</span></h2>{message}"
-            f"<table>{table}</table>{figures}</section>")
+            f"{warnings}<table>{table}</table>{figures}</section>")
 
 
-def report_html(rows: Sequence[dict[str, Any]], pictures: dict[str, dict[str, str]],
+def report_html(rows: Sequence[JobResult], pictures: dict[str, dict[str, str]],
                 title: str) -> str:
     """The batch report: a summary, then one section per job, those needing a look first.
 
     Parameters
     ----------
-    rows : list of dict, summary rows (``SUMMARY_FIELDS``)
+    rows : list of JobResult
     pictures : dict job name -> dict picture name (``shape``, ``difference``, ``energy``) ->
         base64 PNG
     title : str, the page's heading (the manifest's name)
     """
-    jobs = "".join(_job(r, pictures.get(r["job"], {})) for r in ordered(rows))
+    jobs = "".join(_job(r, pictures.get(r.job, {})) for r in ordered(rows))
     return ("<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<title>{html.escape(title)}</title><style>{STYLE}</style></head><body>"
             f"<h1>{html.escape(title)}</h1>{_summary(rows)}{jobs}</body></html>\n")
@@ -121,43 +116,78 @@ def encode_png(data: bytes) -> str:
     return base64.b64encode(data).decode("ascii")
 
 
-def junit_xml(rows: Sequence[dict[str, Any]], suite: str) -> str:
-    """JUnit XML of a batch: one test case per job (class name ``srarap.<suite>``). A failed
-    job is an ``error``; a regressed or unconverged one a ``failure``; an up-to-date one
-    ``skipped`` (not solved in this run: its recorded result stands); the message line and
-    the distances in each."""
-    cases, failures, errors, skipped = [], 0, 0, 0
+#: characters XML 1.0 does not allow, even escaped (and lone surrogates, which no encoder
+#: writes): shown as ``\\xNN`` / ``\\uNNNN`` instead
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
+def xml_text(text: str) -> str:
+    """``text`` with the characters XML 1.0 forbids written out visibly.
+
+    Examples
+    --------
+    >>> xml_text("job\x01\x1b[31m")
+    'job\\\\x01\\\\x1b[31m'
+    """
+    return _NOT_XML.sub(lambda m: f"\\x{ord(m.group()):02x}" if ord(m.group()) < 0x100
+                        else f"\\u{ord(m.group()):04x}", text)
+
+
+def _attr(text: str) -> str:
+    return quoteattr(xml_text(text))
+
+
+def junit_xml(rows: Sequence[JobResult], suite: str) -> str:
+    """JUnit XML of a batch: one test case per job (class name ``srarap.<suite>``).
+
+    A failed or interrupted job is an ``error``, a regressed or unconverged one a
+    ``failure``, each with its text in ``message`` and in the element's body (what GitLab
+    and Jenkins show); an up-to-date job passed (its recorded result stands: the property
+    ``<job>.solved`` is ``false``). A job's warnings are its ``system-err`` and the property
+    ``<job>.warnings`` counts them. Characters XML forbids in names and texts are written
+    out (:func:`xml_text`), so the file parses whatever a job is called.
+    """
+    cases, failures, errors = [], 0, 0
+    properties = []
     for r in rows:
-        status = r["status"]
-        detail = _detail(r)
-        inner = ""
-        if status in ("failed", "interrupted"):
+        detail, inner = _detail(r), ""
+        if r.status in (JobStatus.FAILED, JobStatus.INTERRUPTED):
             errors += 1
-            inner = f"<error type={quoteattr(status)} message={quoteattr(detail)}/>"
-        elif status in ("regressed", "not-converged"):
+            inner = (f"<error type={_attr(r.status.value)} message={_attr(detail)}>"
+                     f"{escape(xml_text(detail))}</error>")
+        elif r.status in (JobStatus.REGRESSED, JobStatus.NOT_CONVERGED):
             failures += 1
-            inner = f"<failure type={quoteattr(status)} message={quoteattr(detail)}/>"
-        elif status == "up-to-date":
-            skipped += 1
-            inner = f"<skipped message={quoteattr(detail)}/>"
-        cases.append(f"    <testcase name={quoteattr(r['job'])} "
-                     f"classname={quoteattr('srarap.' + suite)} "
-                     f"time=\"{(r['seconds'] or 0.0):.3f}\">{inner}</testcase>")
-    seconds = sum(r["seconds"] or 0.0 for r in rows)
+            inner = (f"<failure type={_attr(r.status.value)} message={_attr(detail)}>"
+                     f"{escape(xml_text(detail))}</failure>")
+        if r.warnings:
+            inner += ("<system-err>" + escape(xml_text("".join(f"warning: {w}\n"
+                                                               for w in r.warnings)))
+                      + "</system-err>")
+        properties.append(f"      <property name={_attr(r.job + '.warnings')} "
+                          f"value=\"{len(r.warnings)}\"/>")
+        if r.status is JobStatus.UP_TO_DATE:
+            properties.append(f"      <property name={_attr(r.job + '.solved')} "
+                              "value=\"false\"/>")
+        cases.append(f"    <testcase name={_attr(r.job)} "
+                     f"classname={_attr('srarap.' + suite)} "
+                     f"time=\"{(r.seconds or 0.0):.3f}\">{inner}</testcase>")
+    seconds = sum(r.seconds or 0.0 for r in rows)
     head = (f"tests=\"{len(rows)}\" failures=\"{failures}\" errors=\"{errors}\" "
             f"time=\"{seconds:.3f}\"")
     return ("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-            f"<testsuites name={quoteattr(suite)} {head}>\n"
-            f"  <testsuite name={quoteattr(suite)} {head} skipped=\"{skipped}\">\n"
+            f"<testsuites name={_attr(suite)} {head}>\n"
+            f"  <testsuite name={_attr(suite)} {head} skipped=\"0\">\n"
+            "    <properties>\n" + "\n".join(properties) + "\n    </properties>\n"
             + "\n".join(cases) + "\n  </testsuite>\n</testsuites>\n")
 
 
 def _detail(row):
-    parts = [row["status"]]
-    if row.get("message"):
-        parts.append(row["message"])
-    if row.get("compare_max") is not None:
-        parts.append(f"distance to golden: max {row['compare_max']:.3g}, mean "
-                     f"{_number(row.get('compare_mean'), '.3g')}, tol "
-                     f"{_number(row.get('tol'), 'g')}")
+    parts = [row.status.value]
+    if row.message:
+        parts.append(row.message)
+    if row.compare_max is not None:
+        parts.append(f"distance to golden: max {row.compare_max:.3g}, mean "
+                     f"{_number(row.compare_mean, '.3g')}, tol {_number(row.tol, 'g')}")
+    if row.warnings:
+        parts.append(f"{len(row.warnings)} warning(s)")
     return "; ".join(parts)

@@ -13,11 +13,13 @@ import numpy as np
 from ...runtime.commit import atomic_write
 from ...runtime.errors import InputError, OutputError
 from ...runtime.limits import MAX_COORDINATE, check_read
-from .formats import FORMATS, MeshFormat, by_extension, extensions, register_format
+from .formats import FORMATS, HEAD_BYTES, MeshFormat, by_content, by_extension, extensions, register_format
 from .mesh import Mesh
+from .sniff import not_a_mesh
+from .stream import read_mesh_stream
 
-__all__ = ["FORMATS", "Mesh", "MeshFormat", "atomic_write", "format_mesh", "read_mesh",
-           "register_format", "write_mesh"]
+__all__ = ["FORMATS", "Mesh", "MeshFormat", "atomic_write", "format_mesh", "open_mesh",
+           "read_mesh", "register_format", "write_mesh"]
 
 
 def _listed():
@@ -26,29 +28,65 @@ def _listed():
 
 def read_mesh(path: str | os.PathLike, fmt: MeshFormat | None = None) -> Mesh:
     """Read any registered format (OBJ, OFF, PLY, STL, ...; see :mod:`.formats`) into a
-    :class:`Mesh`, by the file's extension or as ``fmt``.
+    :class:`Mesh`: as ``fmt``, by the file's extension, or, for a name whose extension no
+    format claims (none, ``.txt``, ``/dev/stdin``, a pipe), by its first bytes.
 
     Raises
     ------
     InputError : the file is missing, unreadable, of another format or invalid.
+    TypeError : ``path`` is not a path.
     """
-    fmt = fmt or by_extension(str(path))
-    if fmt is None:
-        suffix = os.path.splitext(str(path))[1].lower()
-        raise InputError(f"{path}: unsupported mesh format {suffix or '(none)'!r}; "
-                         f"use one of {_listed()}")
+    return open_mesh(path, fmt)[0]
+
+
+def open_mesh(path: str | os.PathLike, fmt: MeshFormat | None = None
+              ) -> tuple[Mesh, MeshFormat]:
+    """``(mesh, format)`` of the file ``path``, read as :func:`read_mesh` reads it."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"path must be a file path (str or os.PathLike), got "
+                        f"{type(path).__name__}")
+    path = os.fsdecode(path)
     if os.path.isdir(path):
         raise InputError(f"{path}: is a folder, not a mesh file")
+    fmt = fmt or by_extension(path)
+    if fmt is None:
+        if not os.path.isfile(path):  # a pipe, a device, a process substitution: one pass
+            return _read_stream(path)
+        fmt = _by_content(path)
     check_read(path, fmt.read_factor)
     try:
-        mesh = fmt.read(str(path))
+        mesh = fmt.read(path)
     except InputError:
         raise
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}") \
             from None
     _validate(mesh, path)
-    return mesh
+    return mesh, fmt
+
+
+def _by_content(path):
+    """The format of the regular file ``path`` from its first bytes."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(HEAD_BYTES)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    fmt = by_content(head, os.path.getsize(path))
+    if fmt is None:
+        raise InputError(not_a_mesh(path, head))
+    return fmt
+
+
+def _read_stream(path):
+    try:
+        stream = open(path, "rb")
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    with stream:
+        mesh, fmt = read_mesh_stream(stream, name=path)
+    _validate(mesh, path)
+    return mesh, fmt
 
 
 def _validate(mesh, path):

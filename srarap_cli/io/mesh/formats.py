@@ -37,7 +37,9 @@ class MeshFormat:
     read_factor : float, bytes of memory parsing holds per byte of file (the memory guard
         refuses a file whose parse would not fit)
     signature : callable(head, size) -> bool, whether content starting with the bytes
-        ``head`` (up to :data:`HEAD_BYTES`) in a file of ``size`` bytes is of this format
+        ``head`` (up to :data:`HEAD_BYTES`) in a file of ``size`` bytes is of this format;
+        ``size`` is None for a stream not read to its end (the format is decided from the
+        first bytes, before the rest is spooled)
     description : str, one line for the README's table
     signature_rank : int, signatures are asked in this order (lowest first): an exact test
         (binary STL's size, PLY's magic line) before one on first words (OFF, OBJ)
@@ -53,7 +55,7 @@ class MeshFormat:
     read: Callable[[str], Mesh]
     write: Callable[[Mesh, bool], Written]
     read_factor: float
-    signature: Callable[[bytes, int], bool]
+    signature: Callable[[bytes, int | None], bool]
     description: str = ""
     signature_rank: int = 50
     has_ascii: bool = False
@@ -108,7 +110,7 @@ def by_extension(path: str) -> MeshFormat | None:
     return next((fmt for fmt in FORMATS.values() if ext in fmt.extensions), None)
 
 
-def by_content(head: bytes, size: int) -> MeshFormat | None:
+def by_content(head: bytes, size: int | None) -> MeshFormat | None:
     """The format whose signature accepts ``head`` (a file's first bytes) and ``size``,
     asked by ``signature_rank``, or None."""
     ranked = sorted(FORMATS.values(), key=lambda fmt: fmt.signature_rank)
@@ -136,26 +138,43 @@ def _first_words(head: bytes) -> list[bytes]:
     return words
 
 
-def _is_ply(head: bytes, size: int) -> bool:
+def _is_ply(head: bytes, size: int | None) -> bool:
     return re.match(rb"(\xef\xbb\xbf)?ply\r?\n", head) is not None
 
 
-def _is_binary_stl(head: bytes, size: int) -> bool:
-    if size < 84 or len(head) < 84:
+def _is_binary_stl(head: bytes, size: int | None) -> bool:
+    if len(head) < 84 or (size is not None and size < 84):
         return False
-    return 84 + 50 * int(np.frombuffer(head[80:84], "<u4")[0]) == size
+    count = int(np.frombuffer(head[80:84], "<u4")[0])
+    if size is not None:
+        return 84 + 50 * count == size
+    # a stream, whose size is not known yet: not text (a record's attribute bytes and the
+    # low bytes of round numbers are zeros), and the triangles in ``head`` numbers a mesh
+    # holds (random bytes give a NaN or a huge value in nearly every record)
+    if min(head[84:], default=0) >= 9:
+        return False
+    numbers = _stl_numbers(head, min(count, (len(head) - 84) // 50))
+    return count > 0 and bool(np.isfinite(numbers).all() and (np.abs(numbers) < 1e30).all())
 
 
-def _is_ascii_stl(head: bytes, size: int) -> bool:
+def _stl_numbers(head: bytes, whole: int) -> np.ndarray:
+    """The 12 numbers (normal, three corners) of each of the first ``whole`` records."""
+    rows = np.frombuffer(head, np.uint8, count=50 * whole, offset=84).reshape(whole, 50)
+    return np.ascontiguousarray(rows[:, :48]).view("<f4")
+
+
+def _is_ascii_stl(head: bytes, size: int | None) -> bool:
     words = _first_words(head)
-    return bool(words) and words[0].lower() == b"solid" and not _is_binary_stl(head, size)
+    # on a stream (size None) either variant is STL: the reader tells them apart by the size
+    return bool(words) and words[0].lower() == b"solid" and (
+        size is None or not _is_binary_stl(head, size))
 
 
-def _is_stl(head: bytes, size: int) -> bool:
+def _is_stl(head: bytes, size: int | None) -> bool:
     return _is_binary_stl(head, size) or _is_ascii_stl(head, size)
 
 
-def _is_off(head: bytes, size: int) -> bool:
+def _is_off(head: bytes, size: int | None) -> bool:
     words = _first_words(head)
     return bool(words) and words[0].upper().endswith(b"OFF")
 
@@ -164,7 +183,7 @@ _OBJ_WORDS = {b"v", b"vt", b"vn", b"vp", b"f", b"l", b"p", b"o", b"g", b"s", b"m
               b"usemtl", b"cstype", b"deg", b"curv", b"surf"}
 
 
-def _is_obj(head: bytes, size: int) -> bool:
+def _is_obj(head: bytes, size: int | None) -> bool:
     words = _first_words(head)
     return bool(words) and all(w in _OBJ_WORDS for w in words[:8])
 

@@ -1,0 +1,227 @@
+"""One deformation job, files in and files out: the path ``srarap deform`` and every job of
+``srarap batch`` take, so that both check, warn, fail and write alike.
+
+:func:`run_job` checks the outputs, reads the mesh and the handle file, solves, encodes,
+commits every file at once and compares with a golden mesh; it returns a :class:`JobResult`
+(or raises, for the command line to map to its exit code). :func:`run_job_safely` never
+raises: a failure is a result with status ``failed`` and the exit code ``srarap deform``
+gives for it (:func:`srarap_cli.runtime.failures.classify`).
+"""
+import os
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..io.mesh.formats import MeshFormat, by_extension, extensions
+from ..io.solve_log import LOG_FORMATS, format_log
+from ..runtime import descriptors, memory
+from ..runtime.commit import commit_files
+from ..runtime.errors import NumericalError, OutputError, UsageProblem
+from ..runtime.failures import classify
+from ..runtime.limits import check_solve
+from ..solver.settings import resolve
+from ..solver.stop import StopReason
+from .distortion import vertex_distortion
+from .golden import check_golden
+from .info import up_axis
+from .job_record import fingerprint, read_record, record_bytes, sidecar_path
+from .job_status import JobResult, JobStatus
+from .pipeline import deform_mesh, refuse_warnings
+from .preflight import check_output_path, load_posed, read_any_mesh, refuse_overwrite
+from .preview import preview_png
+
+__all__ = ["DeformJob", "JobResult", "JobStatus", "recorded_result", "run_job",
+           "run_job_safely"]
+
+
+@dataclass(frozen=True)
+class DeformJob:
+    """What one deformation reads and writes.
+
+    Attributes
+    ----------
+    mesh, handles : str, input paths (``mesh`` ``-``: standard input)
+    output : str, the mesh to write (``-``: standard output)
+    settings : mapping, solver settings over the handle file's (``max_iter``, ``strict``...)
+    name : str, the job's name in a batch's summary
+    input_format, output_format : MeshFormat, optional, for a mesh on a stream
+    ascii, write_distortion : bool, the output's variant and its ``distortion`` property
+    log, preview : str, optional, the energy log (.csv/.jsonl) and a PNG to write too
+    preview_up : str, the axis drawn upward in the preview (``auto``: guessed)
+    keep_unconverged : bool, write the mesh of a solve that did not converge
+    cache : str, optional, folder of simplified meshes (multiresolution)
+    fps, frame : the pose of keyframed groups
+    expect : mapping, optional, ``golden`` (path), ``tol``, ``relative``: compare with it
+    record : bool, keep a record beside the output and take an unchanged job's result from
+        it without solving (batches)
+    """
+
+    mesh: str
+    handles: str
+    output: str
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    name: str = ""
+    input_format: MeshFormat | None = None
+    output_format: MeshFormat | None = None
+    ascii: bool = False
+    write_distortion: bool = False
+    log: str | None = None
+    preview: str | None = None
+    preview_up: str = "auto"
+    keep_unconverged: bool = False
+    cache: str | None = None
+    fps: float | None = None
+    frame: float = 0.0
+    expect: Mapping[str, Any] | None = None
+    record: bool = False
+
+
+def run_job(job: DeformJob, callback: Callable[[dict], None] | None = None,
+            write_stdout: Callable[[bytes], None] | None = None) -> JobResult:
+    """Run ``job``; raise on failure (InputError, OutputError, NumericalError, ...).
+
+    ``callback`` receives each log row of the solve; ``write_stdout`` takes the mesh's bytes
+    when the output is ``-`` (before any file is committed). The result's ``status`` is
+    ``ok``, ``up-to-date``, ``not-converged`` or ``regressed``.
+    """
+    start = time.perf_counter()
+    fmt = _preflight(job)
+    result = recorded_result(job) if job.record else None
+    if result is None:
+        result = _solve(job, fmt, callback, write_stdout)
+    if job.expect is not None and result.status is not JobStatus.NOT_CONVERGED \
+            and os.path.exists(job.output):
+        check_golden(result, job.expect, job.output)
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def run_job_safely(job: DeformJob, **kwargs: Any) -> JobResult:
+    """:func:`run_job`, with a failure returned as a ``failed`` result, never raised."""
+    start = time.perf_counter()
+    try:
+        return run_job(job, **kwargs)
+    except Exception as exc:  # noqa: BLE001 -- a failing job is reported, never fatal
+        code, text = classify(exc)
+        return JobResult(job.name, JobStatus.FAILED, code, message=text.splitlines()[0]
+                         if text else type(exc).__name__,
+                         stop=StopReason.NON_FINITE.value if isinstance(exc, NumericalError)
+                         else "", seconds=time.perf_counter() - start)
+
+
+def _preflight(job):
+    """Check the outputs before any work; the output's format (None: standard input's)."""
+    fmt = _output_format(job)
+    if fmt is not None:
+        _check_format_options(fmt, job)
+    if job.output != "-":  # an extension the table knows, or --format for a name without one
+        check_output_path(job.output, None if by_extension(job.output) is None
+                          and job.output_format else extensions(), "output")
+    elif descriptors.closed(1):
+        raise OutputError("-o -: standard output is closed; name an output file")
+    if job.preview is not None:
+        check_output_path(job.preview, (".png",), "preview")
+    if job.log is not None:
+        check_output_path(job.log, LOG_FORMATS, "log")
+        if os.path.abspath(job.log) == os.path.abspath(job.output):
+            raise UsageProblem("--log and --output name the same file")
+    refuse_overwrite([job.output, job.log, job.preview], mesh=job.mesh, handles=job.handles)
+    return fmt
+
+
+def _output_format(job):
+    """``--format``, or the output's extension; for ``-o -`` without ``--format``, the input
+    file's, or None for standard input (its bytes decide)."""
+    if job.output == "-":
+        return job.output_format or (None if job.mesh == "-" else by_extension(job.mesh))
+    fmt = by_extension(job.output)
+    if job.output_format is not None and fmt is not None and fmt is not job.output_format:
+        raise UsageProblem(f"--format {job.output_format.name} does not match the output "
+                           f"{job.output!r}")
+    return fmt or job.output_format
+
+
+def _check_format_options(fmt, job):
+    from ..io.mesh import FORMATS
+
+    def having(attribute):
+        return "/".join(f.name.upper() for f in FORMATS.values() if getattr(f, attribute))
+
+    if job.ascii and not fmt.has_ascii:
+        raise UsageProblem(f"--ascii applies to {having('has_ascii')} output only")
+    if job.write_distortion and not fmt.keeps_vertex_data:
+        raise UsageProblem(f"--write-distortion needs a {having('keeps_vertex_data')} output")
+
+
+def recorded_result(job: DeformJob) -> JobResult | None:
+    """The result an unchanged job's record gives, or None (the job runs)."""
+    key = fingerprint(job.mesh, job.handles, job.settings, os.path.basename(job.output))
+    rec = read_record(sidecar_path(job.output), key)
+    if rec is None:
+        return None
+    status = JobStatus(rec["status"])
+    if status is JobStatus.OK and os.path.exists(job.output):
+        status = JobStatus.UP_TO_DATE
+    elif not (status is JobStatus.NOT_CONVERGED and not job.keep_unconverged):
+        return None  # the output is gone, or this run writes what that one did not
+    return JobResult(job.name, status, status.exit_code, warnings=rec["warnings"],
+                     stop=rec["stop"] or "", iterations=rec["iterations"],
+                     energy=rec["energy"], solved=False,
+                     message="" if status is JobStatus.UP_TO_DATE
+                     else "inputs unchanged since the recorded run")
+
+
+def _solve(job, fmt, callback, write_stdout):
+    peaks: dict[str, int | None] = {}
+    peak = memory.start()
+    source, source_format = read_any_mesh(job.mesh, job.input_format)
+    peaks["read"] = memory.stop(peak)
+    if fmt is None:
+        fmt = source_format
+        _check_format_options(fmt, job)
+    name = "<stdin>" if job.mesh == "-" else job.mesh
+    check_solve(name, len(source.vertices))
+    constraints = load_posed(job.handles, source.vertices, job.fps, job.frame)
+    opts = resolve(constraints.solver, dict(job.settings))
+    peak = memory.start()
+    deformed, solve, notes = deform_mesh(source, constraints, opts, callback=callback,
+                                         cache=job.cache, name=name)
+    peaks["solve"], peak = memory.stop(peak), memory.start()
+    if job.write_distortion:
+        deformed.vertex_data["distortion"] = vertex_distortion(
+            source.vertices, deformed.vertices, source.triangles()[0])
+    mesh_bytes, lost = fmt.encode(deformed, job.ascii)
+    refuse_warnings(opts, lost)
+    status = JobStatus.OK if solve.complete else JobStatus.NOT_CONVERGED
+    keep = solve.complete or job.keep_unconverged
+    files = _files(job, keep, mesh_bytes, deformed, source, constraints, solve)
+    if job.record:
+        key = fingerprint(job.mesh, job.handles, job.settings, os.path.basename(job.output))
+        files.append((sidecar_path(job.output), record_bytes(
+            key, status.value, solve.iterations, solve.energy, solve.stop_reason.value,
+            notes + lost)))
+    if keep and job.output == "-" and write_stdout is not None:
+        write_stdout(mesh_bytes)  # first: the files are committed only once it was written
+    commit_files(files)
+    peaks["write"] = memory.stop(peak)
+    return JobResult(job.name, status, status.exit_code, warnings=notes + lost,
+                     stop=solve.stop_reason.value, iterations=solve.iterations,
+                     energy=solve.energy, solved=True,
+                     message="" if keep else "mesh not written (--keep-unconverged writes it)",
+                     written=job.output if keep else None, peaks=peaks, solve=solve,
+                     settings=opts, seen={"mesh": source, "deformed": deformed,
+                                          "constraints": constraints, "log": solve.log})
+
+
+def _files(job, keep, mesh_bytes, deformed, source, constraints, solve):
+    """The files a job commits together: the mesh, its preview and the log."""
+    files = [(job.output, mesh_bytes)] if keep and job.output != "-" else []
+    if job.preview is not None and keep:
+        up = up_axis(source) if job.preview_up == "auto" else job.preview_up
+        files.append((job.preview, preview_png(deformed, source, constraints, view="iso",
+                                               up=up)))
+    if job.log is not None:
+        files.append((job.log, format_log(solve.log, os.path.splitext(job.log)[1].lower())
+                      .encode()))
+    return files

@@ -1,0 +1,54 @@
+"""A job's record beside its output (``<output>.srarap.json``): the fingerprint of everything
+that decides the output and how the job ended, so that a rerun of an unchanged job reports
+that result again without solving."""
+import hashlib
+import json
+from collections.abc import Mapping, Sequence
+from importlib import metadata
+from typing import Any
+
+from ..io.handles import referenced_files
+from ..io.input_files import read_input_bytes
+from ..runtime.errors import InputError
+
+#: what a record keeps of a job's result
+RECORDED = ("status", "iterations", "energy", "stop", "warnings")
+
+
+def sidecar_path(output: str) -> str:
+    """The record of the job writing ``output``."""
+    return output + ".srarap.json"
+
+
+def fingerprint(mesh: str, handles: str, settings: Mapping[str, Any], output: str) -> str:
+    """Content hash of the mesh, the handle file and every file it names, the settings, the
+    output's name and srarap's version."""
+    h = hashlib.sha256()
+    for path in (mesh, handles, *referenced_files(handles)):
+        try:
+            h.update(hashlib.sha256(read_input_bytes(path)).digest())
+        except InputError:
+            h.update(b"missing:" + path.encode("utf-8", "surrogateescape"))
+    h.update(json.dumps([dict(settings), output, metadata.version("srarap-cli")],
+                        sort_keys=True).encode())
+    return h.hexdigest()
+
+
+def read_record(sidecar: str, key: str) -> dict[str, Any] | None:
+    """What the record at ``sidecar`` says of the job with fingerprint ``key``; None when
+    there is none, it is unreadable, of other inputs, or older than status records."""
+    try:
+        with open(sidecar) as fh:
+            rec = json.load(fh)
+    except (OSError, ValueError):
+        return None
+    if not isinstance(rec, dict) or rec.get("fingerprint") != key or "status" not in rec:
+        return None
+    return {k: rec.get(k) for k in RECORDED} | {"warnings": list(rec.get("warnings") or [])}
+
+
+def record_bytes(key: str, status: str, iterations: int | None, energy: float | None,
+                 stop: str, warnings: Sequence[str]) -> bytes:
+    """The record's file content."""
+    return json.dumps({"fingerprint": key, "iterations": iterations, "energy": energy,
+                       "status": status, "stop": stop, "warnings": list(warnings)}).encode()

@@ -1,0 +1,102 @@
+"""How a job ended: a status, its exit code, and the figures every report of it shows (the
+batch's console table, ``summary.csv`` / ``summary.json``, the HTML report, JUnit)."""
+import enum
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..runtime import exit_codes
+
+#: the columns of a batch's ``summary.csv`` (``summary.json`` holds ``warnings`` as a list;
+#: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason`, empty for a job that
+#: never reached the solver)
+SUMMARY_FIELDS = ("job", "status", "stop", "iterations", "energy", "seconds", "compare_max",
+                  "message", "compare_mean", "tol", "exit_code", "warnings")
+#: how warnings are joined in one CSV cell
+WARNING_JOIN = " | "
+
+
+class JobStatus(enum.Enum):
+    """A job's outcome, in the order a reviewer needs to see them."""
+
+    FAILED = "failed"
+    REGRESSED = "regressed"
+    NOT_CONVERGED = "not-converged"
+    INTERRUPTED = "interrupted"
+    OK = "ok"
+    UP_TO_DATE = "up-to-date"
+
+    @property
+    def exit_code(self) -> int:
+        """The exit code ``srarap deform`` / ``compare`` gives for the same outcome (a failed
+        job's own code is on its result; 1 stands for one unknown)."""
+        return _EXIT_CODES[self]
+
+    @property
+    def passed(self) -> bool:
+        return self in (JobStatus.OK, JobStatus.UP_TO_DATE)
+
+
+_EXIT_CODES = {JobStatus.OK: exit_codes.OK, JobStatus.UP_TO_DATE: exit_codes.OK,
+               JobStatus.NOT_CONVERGED: exit_codes.NOT_CONVERGED,
+               JobStatus.REGRESSED: exit_codes.BEYOND_TOLERANCE,
+               JobStatus.INTERRUPTED: exit_codes.INTERRUPTED,
+               JobStatus.FAILED: exit_codes.INTERNAL_ERROR}
+
+
+@dataclass
+class JobResult:
+    """One job's result.
+
+    Attributes
+    ----------
+    job : str, the job's name
+    status : JobStatus
+    exit_code : int, what ``srarap deform`` exits with for this outcome
+    message : str, one line on why it failed, regressed or wrote no mesh
+    warnings : list of str, every warning of the run (handle file, mesh, solver, output)
+    stop : str, the solve's stop reason; iterations, energy: its figures (None unsolved)
+    seconds : float, the job's wall time
+    compare_max, compare_mean, tol : distances to the golden mesh and the tolerance
+    solved : bool, the solver ran in this run (False: an unchanged job's recorded result)
+    written : str, the output mesh written, or None
+    peaks : dict stage -> bytes, peak memory per stage (``-v``)
+    solve : DeformResult, settings : Settings, the solve and its settings (in the process
+        that ran it; not sent between processes)
+    seen : dict, what the report's pictures are drawn from
+    pictures : dict name -> base64 PNG, the report's pictures of the job
+    """
+
+    job: str
+    status: JobStatus
+    exit_code: int
+    message: str = ""
+    warnings: list[str] = field(default_factory=list)
+    stop: str = ""
+    iterations: int | None = None
+    energy: float | None = None
+    seconds: float | None = None
+    compare_max: float | None = None
+    compare_mean: float | None = None
+    tol: float | None = None
+    solved: bool = False
+    written: str | None = None
+    peaks: dict[str, int | None] = field(default_factory=dict, repr=False)
+    solve: Any = field(default=None, repr=False)
+    settings: Any = field(default=None, repr=False)
+    seen: dict[str, Any] = field(default_factory=dict, repr=False)
+    pictures: dict[str, str] = field(default_factory=dict, repr=False)
+
+    def row(self) -> dict[str, Any]:
+        """The summary row: :data:`SUMMARY_FIELDS`, ``warnings`` a list."""
+        return {"job": self.job, "status": self.status.value, "stop": self.stop,
+                "iterations": self.iterations, "energy": self.energy, "seconds": self.seconds,
+                "compare_max": self.compare_max, "message": self.message,
+                "compare_mean": self.compare_mean, "tol": self.tol, "exit_code": self.exit_code,
+                "warnings": list(self.warnings)}
+
+    def shipped(self) -> "JobResult":
+        """This result without what stays in the process that ran it (the solve's arrays),
+        as a worker sends it back."""
+        self.solve = self.settings = None
+        self.seen = {}
+        return self
