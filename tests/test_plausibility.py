@@ -33,10 +33,21 @@ def test_radians_beyond_a_full_turn_warn_with_the_value_in_degrees(radians):
     assert "angle_deg" in w
 
 
-@pytest.mark.parametrize("radians", [0.0, 0.5, -2 * np.pi, 2 * np.pi])
-def test_radians_within_a_turn_and_explicit_degrees_are_quiet(radians):
+@pytest.mark.parametrize("radians", [0.0, 0.5, -3.0, 3.0])
+def test_radians_within_half_a_turn_and_explicit_degrees_are_quiet(radians):
     assert warnings_of({"rotate": {"axis": [0, 0, 1], "angle_rad": radians}}) == []
-    assert warnings_of({"rotate": {"axis": [0, 0, 1], "angle_deg": 3000.0}}) == []
+    assert warnings_of({"rotate": {"axis": [0, 0, 1], "angle_deg": -179.0}}) == []
+
+
+@pytest.mark.parametrize("key, value, same", [("angle_deg", 3000.0, "120"),
+                                              ("angle_deg", -190.0, "170"),
+                                              ("angle_rad", 2 * np.pi, None),
+                                              ("angle_deg", 1080, None)])
+def test_a_static_turn_beyond_half_a_turn_says_what_it_reaches(key, value, same):
+    """A static solve sees only where the vertices end: 3000 degrees lands where 120 does,
+    a whole number of turns at the rest pose."""
+    (w,) = warnings_of({"rotate": {"axis": [0, 0, 1], key: value}})
+    assert (f"same targets as {same} degrees" in w) if same else ("whole turn(s)" in w)
 
 
 def test_an_angle_without_unit_says_degrees_were_assumed_and_suspects_radians_when_small():

@@ -19,7 +19,8 @@ from ..runtime.errors import InputError, OutputError
 from ..runtime.limits import check_solve
 from ..solver.settings import resolve
 from ..solver.stop import StopReason
-from ..tasks.animation import FRAME_FIELDS, Animator, FrameState, fingerprint
+from ..tasks.animation import FRAME_FIELDS, Animator, FrameState, fingerprint, unreached_keys
+from ..tasks.pipeline import refuse_warnings
 from ..tasks.preflight import check_output_path, refuse_overwrite
 from .common import cache_option, finite_option, guarded, report, with_verbosity
 from .options import settings_options
@@ -87,7 +88,10 @@ def animate(mesh: str, handles: str, pattern: str, frames: int | None, fps: floa
     progress = _Progress(n_frames, enabled=verbosity != 0 and sys.stderr.isatty())
 
     frame_bytes = frame_formatter(source, _suffix(pattern))
-    lost = format_mesh(source, _suffix(pattern))[1]  # what every frame's file loses, said once
+    # what every frame's file loses, and keys no frame shows: said once, errors under strict
+    lost = format_mesh(source, _suffix(pattern))[1] + unreached_keys(constraints, n_frames, fps,
+                                                                      handles)
+    refuse_warnings(opts, lost)
 
     def write_frame(f, positions, st):
         commit_files([(pattern.format(f), frame_bytes(positions)), (state_path, st.to_bytes())])

@@ -119,7 +119,7 @@ def _tell(rows, out, quiet, stopped):
 
 
 def printable(text: str) -> str:
-    """``text`` for one line of a terminal: control characters (an ESC sequence, a newline)
+    r"""``text`` for one line of a terminal: control characters (an ESC sequence, a newline)
     written out, so a job's name can neither colour the terminal nor break the table.
 
     Examples

@@ -50,6 +50,7 @@ def guarded(func: Callable[..., None]) -> Callable[..., None]:
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
         debug = click.get_current_context().find_root().params.get("debug", False)
+        COMMITTED.clear()  # this command's files only (a host may run several in-process)
         try:
             # non-finite results are detected and reported as numerical failures; numpy's own
             # floating-point warnings would only add multi-line noise to stderr

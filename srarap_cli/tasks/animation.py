@@ -84,7 +84,7 @@ class Animator:
         self.problem = problem(mesh, constraints, name)
         #: warnings: what the mesh checks and the solver found (e.g. mesh problems)
         self.deformer, self.warnings = command_solver(mesh, self.problem, opts, cache,
-                                                      constraints.warnings)
+                                                      constraints.warnings, constraints)
         self.last_result: DeformResult | None = None
 
     def run(self, frames: int, *, max_iter: int | None = None, stop_unconverged: bool = False,
@@ -161,3 +161,26 @@ def fingerprint(paths: Sequence[str], opts: Settings, *extra: Any) -> str:
         h.update(hashlib.sha256(read_input_bytes(path)).digest())
     h.update(json.dumps([opts.as_dict(), *extra], sort_keys=True).encode())
     return h.hexdigest()
+
+
+def unreached_keys(constraints: Constraints, n_frames: int, fps: float | None,
+                   path: str = "<handles>") -> list[str]:
+    """A warning per keyframed group with keys after the last frame of an animation of
+    ``n_frames`` frames (frames 0 .. n_frames - 1): no frame shows those poses (keys given
+    in seconds at a high ``fps`` that all fall before frame 1, or ``--frames`` too few)."""
+    out = []
+    names = {tuple(constraints.ids[slots]): None for slots, _, _ in constraints.tracks}
+    for name, ids in constraints.groups.items():
+        key = tuple(np.sort(np.asarray(ids)))
+        if key in names:
+            names[key] = name
+    for slots, _, track in constraints.tracks:
+        late = track.frames[track.frames > n_frames - 1]
+        if late.size:
+            name = names[tuple(constraints.ids[slots])]
+            rate = f" at --fps {fps:g}" if fps else ""
+            out.append(f"{path}: group {name!r}: {late.size} keyframe(s) at frame(s) "
+                       f"{', '.join(f'{f:.4g}' for f in late[:4])}{rate} come after the last "
+                       f"frame, {n_frames - 1}: no frame shows them (raise --frames, or check "
+                       "the keys' times and --fps)")
+    return out

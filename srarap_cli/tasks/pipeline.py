@@ -17,6 +17,7 @@ from ..solver.operators import mesh_area
 from ..solver.quaternion import IDENTITY
 from ..solver.region import restrict
 from ..solver.settings import STAGES, Settings, resolve, with_keywords
+from .rigid_parts import rigid_part_warnings
 
 
 @dataclass
@@ -85,14 +86,19 @@ def _labels(constraints, full_ids):
 
 
 def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = None,
-                   handle_warnings: Sequence[str] = ()) -> tuple[Solver, list[str]]:
+                   handle_warnings: Sequence[str] = (),
+                   constraints: Constraints | None = None) -> tuple[Solver, list[str]]:
     """The solver of ``p`` for a command (deform, animate) and the warnings of the handle
-    file (``handle_warnings``), the mesh and the solver; under ``opts.strict`` the first
+    file (``handle_warnings``), the mesh, the solver and, given ``constraints``, the parts
+    they carry off rigidly (:mod:`.rigid_parts`); under ``opts.strict`` the first
     warning is raised instead (before the solver is built, where it can be). The mesh checks
     run before the solver is built, so their temporaries (edge tables of the whole mesh) do
     not add to the memory it holds (2M-vertex bar: peak 11.4 -> 10.6 GiB); once it is
     built, the process keeps freed memory for reuse."""
     notes = list(handle_warnings) + mesh_warnings(mesh.vertices, mesh.triangles()[0])
+    if constraints is not None:
+        notes += rigid_part_warnings(mesh.vertices, p.F if p.sub is None else
+                                     solvable_faces(mesh.triangles()[0]), constraints)
     refuse_warnings(opts, notes)
     deformer = make_deformer(p.V, p.F, p.ids, p.labels, settings=opts, area=p.area,
                              cache=cache)
@@ -145,7 +151,8 @@ def deform_mesh(mesh: Mesh, constraints: Constraints, settings: Settings | None 
     settings = with_keywords(settings or resolve(constraints.solver), options, STAGES,
                              "deform_mesh")
     p = problem(mesh, constraints, name)
-    deformer, notes = command_solver(mesh, p, settings, cache, constraints.warnings)
+    deformer, notes = command_solver(mesh, p, settings, cache, constraints.warnings,
+                                     constraints)
     sub_result = deformer.solve(p.targets, callback=callback)
     positions = scatter(mesh, p, sub_result.positions, constraints)
     rotors = np.tile(IDENTITY, (len(positions), 1))

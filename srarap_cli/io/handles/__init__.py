@@ -20,7 +20,7 @@ from .fields import Context
 from .formats import read_def, read_sel
 from .keys import parse_track
 from .selectors import SELECTOR_KEYS, select
-from .transforms import ACTION_KEYS, check_reach, targets
+from .transforms import ACTION_KEYS, check_reach, not_rigid, targets
 
 TOP_KEYS = ("groups", "region", "solver")
 ANIMATION_KEYS = ("keyframes", "easing")
@@ -209,16 +209,22 @@ def _from_sel(path, V):
     if fixed.size + handle.size == 0:
         raise InputError(f"{path}: no vertex has status 0 (fixed) or 2 (handle)")
     t = V.copy()
+    warnings = []
     if handle.size:
         if not os.path.isfile(def_path):
             raise InputError(f"{def_path}: no such file (the .def that goes with {path})")
         M = read_def(def_path)
+        if why := not_rigid(M[:3, :3]):
+            warnings.append(f"{def_path}: the matrix {why}: no rigid motion reaches its "
+                            "targets, so the surface around the handle is stretched or "
+                            "turned inside out")
         t[handle] = V[handle] @ M[:3, :3].T + M[:3, 3]
         if not np.isfinite(t[handle]).all() or np.abs(t[handle]).max() > MAX_COORDINATE:
             raise InputError(f"{def_path}: sends handle vertices to infinite or NaN positions "
                              "(entries too large)")
     ids = np.flatnonzero(status != 1)
-    return Constraints(ids=ids, targets=t[ids], groups={"fixed": fixed, "handle": handle})
+    return Constraints(ids=ids, targets=t[ids], groups={"fixed": fixed, "handle": handle},
+                       warnings=warnings)
 
 
 def referenced_files(handles: str | os.PathLike) -> list[str]:

@@ -65,6 +65,57 @@ def _check_angle(ctx, key, value):
                  "to say which")
 
 
+def not_rigid(A: np.ndarray) -> str:
+    """What keeps the 3x3 matrix ``A`` from being a rotation (``"is a mirror ..."``), or ""
+    for a rotation (up to round-off).
+
+    Examples
+    --------
+    >>> not_rigid(np.diag([1.0, 1.0, -1.0]))
+    'is a mirror (determinant -1)'
+    >>> not_rigid(np.eye(3))
+    ''
+    """
+    det = float(np.linalg.det(A))
+    if det < 0:
+        return f"is a mirror (determinant {det:.3g})"
+    gram = A.T @ A
+    scale = max(float(np.abs(gram).max()), 1e-300)
+    if np.abs(gram - np.diag(np.diag(gram))).max() > 1e-9 * scale:
+        return "shears (its columns are not at right angles)"
+    lengths = np.sqrt(np.diag(gram))
+    if np.ptp(lengths) > 1e-9 * lengths.max():
+        return f"scales unevenly (by {', '.join(f'{x:.3g}' for x in lengths)} along x, y, z)"
+    if abs(lengths[0] - 1) > 1e-9:
+        return f"scales by {lengths[0]:.6g}"
+    return ""
+
+
+def _check_turn(ctx, spec):
+    """Warn where a static rotation's angle says more than its targets can: a solve sees
+    only where the vertices end, so whole turns are the rest pose and 270 degrees is -90."""
+    if not isinstance(spec, dict):
+        return
+    for key, factor in (("angle_deg", 1.0), ("angle_rad", ANGLE_KEYS["angle_rad"])):
+        value = spec.get(key)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not np.isfinite(value) or (key == "angle_rad" and
+                                              abs(value) > 2 * np.pi + 1e-9):
+            continue  # beyond a turn in radians: the unit is suspect, and said so
+        degrees = value * factor
+        turns, rest = divmod(abs(degrees), 360.0)
+        rest = min(rest, 360.0 - rest)
+        if turns >= 1 and rest < 1e-9:
+            ctx.warn(f"{key} {value:g} is {int(turns)} whole turn(s): the targets are the rest "
+                     "pose and nothing turns (a static solve sees only where vertices end; "
+                     "keyframes turn it step by step)")
+        elif abs(degrees) > 180:
+            same = (degrees + 180.0) % 360.0 - 180.0
+            ctx.warn(f"{key} {value:g} reaches the same targets as {same:.6g} degrees: a static "
+                     "solve sees only where vertices end and turns the short way (keyframes "
+                     "turn it step by step)")
+
+
 def _scaled(v):
     """``v`` divided by its largest component: only its direction counts, and the norm of a
     vector with components above about 1e154 overflows (it made such a quaternion the
@@ -127,11 +178,16 @@ def _moved(ctx, spec, rest, base):
         if len(moving) > 1:
             raise ctx.error("matrix cannot be combined with translate, rotate or pivot")
         M = _matrix(ctx, spec["matrix"], base)
+        why = not_rigid(M[:3, :3])
+        if why:
+            ctx.warn(f"matrix {why}: no rigid motion reaches its targets, so the surface "
+                     "around the group is stretched or turned inside out")
         return rest @ M[:3, :3].T + M[:3, 3]
     if "pivot" in spec and "rotate" not in spec:
         raise ctx.error("pivot only applies together with rotate")
     out = rest.copy()
     if "rotate" in spec:
+        _check_turn(ctx, spec["rotate"])
         pivot = (ctx.vector(spec["pivot"], "pivot", 3) if "pivot" in spec
                  else rest.mean(axis=0))
         out = (rest - pivot) @ rotation_matrix(ctx, spec["rotate"]).T + pivot
