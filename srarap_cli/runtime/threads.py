@@ -14,8 +14,10 @@ bit for bit).
 import contextlib
 import functools
 import os
+import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar, cast
 
@@ -194,7 +196,11 @@ def _start_fork_server(preload):
 
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(list(preload))
-    with environ_changed(dict.fromkeys(_VARIABLES, "1")):
+    # the resource tracker's note on semaphores of workers a signal killed is not the
+    # user's concern: it cleans them up
+    quiet = {"PYTHONWARNINGS": ",".join(filter(None, [
+        os.environ.get("PYTHONWARNINGS"), "ignore::UserWarning:multiprocessing.resource_tracker"]))}
+    with environ_changed({**dict.fromkeys(_VARIABLES, "1"), **quiet}):
         # the server starts with SIGINT/SIGTERM held back (the mask outlives exec) until
         # its preload has set them: a Ctrl-C during its imports printed their traceback.
         # Python's resource tracker first: starting it unblocks both, whatever the mask was
@@ -205,11 +211,73 @@ def _start_fork_server(preload):
 
 
 def _stop_fork_server():
+    """Stop the fork server, and first whatever it forked that still runs: the server ends
+    only when every process it forked has (they hold its liveness pipe), and a signal that
+    stopped the block while a Dask cluster started left workers no one would close."""
     from multiprocessing import forkserver
 
-    stop = getattr(getattr(forkserver, "_forkserver", None), "_stop", None)
-    if stop is not None:  # CPython's; elsewhere a server ends with this process
+    server = getattr(forkserver, "_forkserver", None)
+    stop = getattr(server, "_stop", None)
+    if stop is None:  # CPython's; elsewhere a server ends with this process
+        return
+    pid = getattr(server, "_forkserver_pid", None)
+    if pid is None:
+        return stop()
+    stopped = threading.Event()
+
+    def end_late_ones():  # a cluster's thread may still ask the server for workers
+        while not stopped.wait(0.1):
+            end_children(pid)
+
+    end_children(pid)
+    watcher = threading.Thread(target=end_late_ones, daemon=True)
+    watcher.start()
+    try:
         stop()
+    finally:
+        stopped.set()
+
+
+#: seconds the processes a fork server left get after SIGTERM before SIGKILL
+CHILD_GRACE = 2.0
+
+
+def end_children(pid: int, grace: float = CHILD_GRACE) -> None:
+    """SIGTERM to each process whose parent is ``pid``, SIGKILL to those still there after
+    ``grace`` seconds."""
+    children = _children(pid)
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        for child in children:
+            try:
+                os.kill(child, sig)
+            except OSError:
+                pass
+        deadline = time.monotonic() + grace
+        while children and time.monotonic() < deadline:
+            time.sleep(0.02)
+            children = [c for c in children if c in _children(pid)]
+        if not children:
+            return
+
+
+def _children(pid: int) -> list[int]:
+    """The running processes whose parent is ``pid`` (from /proc; none where it is absent)."""
+    found: list[int] = []
+    try:
+        entries = os.listdir("/proc")
+    except OSError:
+        return found
+    for entry in entries:
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat", "rb") as fh:
+                fields = fh.read().rsplit(b")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid and fields[0] != b"Z":
+            found.append(int(entry))
+    return found
 
 
 def _threads() -> int:

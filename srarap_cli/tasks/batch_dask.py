@@ -1,6 +1,7 @@
 """A batch on a Dask cluster (``batch --scheduler``): a local one srarap starts, or one at an
 address; rows in manifest order, a job Dask gave up on a failed row."""
 import functools
+import logging
 import os
 from collections.abc import Callable
 
@@ -60,8 +61,15 @@ def run_on_dask(jobs: list[Job], run: "functools.partial[JobResult]", scheduler:
             worker_processes([WORKER_START, "distributed"], threads_ahead=True) as context:
         with dask.config.set({**LOCAL_CONFIG, "distributed.worker.multiprocessing-method":
                               context.get_start_method()}):
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
+            try:
+                # no HTTP port of its own to fight over ("Port 8787 is already in use"),
+                # and the workers' log lines only for errors: the summary says what happened
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
+                                       processes=True, dashboard_address=":0",
+                                       silence_logs=logging.ERROR)
+            except (KeyboardInterrupt, Terminated):
+                _silence_dask()  # the half-started cluster's tasks end unattended
+                raise
         try:
             return _gather_at(cluster, jobs, run, scheduler, unfinished)
         finally:
@@ -87,11 +95,11 @@ def _without_dasks_trim_setting():
 
 
 def _silence_dask():
-    """Dask's and asyncio's log lines while a cluster is stopped early (cancelled tasks,
-    lost workers, the interrupted gather's tasks collected later) are not the user's
+    """Dask's, asyncio's and tornado's log lines while a cluster is stopped early (cancelled
+    tasks, lost workers, the interrupted gather's tasks collected later) are not the user's
     concern: the summary says what finished. For the rest of the process, which is ending."""
     import logging
-    for name in ("distributed", "asyncio"):
+    for name in ("distributed", "asyncio", "tornado"):
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
