@@ -3,7 +3,6 @@ import os
 import struct
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
@@ -50,13 +49,12 @@ VERTS = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
     ("badline.ply", b"ply\nformat ascii 1.0\nelement vertex many\nend_header\n",
      "bad PLY header line"),
 ])
+@pytest.mark.timeout(60)  # a hang is the failure
 def test_broken_ply_files_are_one_input_error_quickly(tmp_path, name, data, message):
     path = tmp_path / name
     path.write_bytes(data)
-    start = time.perf_counter()
     with pytest.raises(InputError, match=message) as err:
         read_mesh(str(path))
-    assert time.perf_counter() - start < 5  # a bound against hangs, not a benchmark
     assert str(path) in str(err.value) and "\n" not in str(err.value)
 
 
@@ -134,14 +132,24 @@ def alias_bomb(levels=9, width=9):
     ("bomb.yaml", alias_bomb(), "expands to more than"),
     ("deep.yaml", "groups: " + "[" * 1000 + "]" * 1000 + "\n", "nested too deeply"),
     ("deep.json", '{"groups": ' + "[" * 5000 + "]" * 5000 + "}", "nested too deeply"),
+    ("self.yaml", "a: &a [*a]\ngroups: {f: {indices: [0], fixed: true}}\n", "refers to itself"),
+    ("self-map.yaml", "a: &a {b: [1, {c: *a}]}\ngroups: {}\n", "refers to itself"),
 ])
-def test_yaml_bombs_and_deep_nesting_are_refused_quickly(tmp_path, name, text, message):
+@pytest.mark.timeout(60)  # a hang is the failure
+def test_yaml_bombs_and_deep_nesting_are_refused_quickly(tmp_path, name, text, message,
+                                                         monkeypatch):
+    """Refused after a walk of the composed graph that visits each node once: the work is
+    counted in nodes, not the 10^9 the aliases expand to (nor forever, for a cycle)."""
+    from srarap_cli.io import documents
+
+    visited = []
+    real = documents._children
+    monkeypatch.setattr(documents, "_children", lambda node: visited.append(1) or real(node))
     path = tmp_path / name
     path.write_text(text)
-    start = time.perf_counter()
     with pytest.raises(InputError, match=message):
         load_handles(str(path), np.zeros((3, 3)))
-    assert time.perf_counter() - start < 5
+    assert len(visited) < 50_000
 
 
 def test_aliases_within_bounds_still_work(tmp_path):

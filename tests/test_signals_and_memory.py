@@ -136,10 +136,8 @@ def test_the_memory_guard_takes_the_address_space_limit(big):
 def test_running_out_of_memory_is_exit_4_and_one_line(big, limit):
     """The guard told to assume plenty: the allocation fails for real, somewhere in numpy,
     SuperLU or libigl, and the run ends promptly with one line about memory."""
-    start = time.perf_counter()
     p = _run_limited(big, limit, {"SRARAP_MEMORY_LIMIT": "1e12"}, "deform", "big.obj",
-                     "h.yaml", "-o", "o.obj", "--multires", "off")
-    assert time.perf_counter() - start < 100  # a hang is the failure; timing not asserted tighter
+                     "h.yaml", "-o", "o.obj", "--multires", "off")  # a hang: its timeout
     # 48k vertices direct need about 0.9 GB of address space: both limits are too small
     assert p.returncode == 4, p.stderr
     assert p.stderr.startswith("srarap: error: out of memory") and p.stderr.count("\n") == 1

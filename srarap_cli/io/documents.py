@@ -49,6 +49,8 @@ def load_document(path: str, kind: str) -> Any:
             return doc
         _check_graph(yaml.compose(text, Loader=yaml.SafeLoader), path)
         return yaml.safe_load(text)
+    except InputError:
+        raise
     except RecursionError:
         raise InputError(f"{path}: nested too deeply (at most {MAX_DEPTH} levels)") from None
     except UnicodeDecodeError as exc:
@@ -73,6 +75,7 @@ def _check_graph(root, path):
     if root is None:
         return
     size, depth = {}, {}
+    open_ = set()  # nodes whose children are being measured: meeting one again is a cycle
     stack = [(root, False)]
     while stack:
         node, done = stack.pop()
@@ -81,9 +84,20 @@ def _check_graph(root, path):
             continue
         kids = _children(node)
         if not done:
+            if key in open_:
+                continue  # the same node queued twice before it was measured
+            open_.add(key)
             stack.append((node, True))
-            stack.extend((k, False) for k in kids if id(k) not in size)
+            for kid in kids:
+                if id(kid) in open_:
+                    raise InputError(f"{path}: refers to itself (an alias used inside the "
+                                     "node it names"
+                                     + (f", line {kid.start_mark.line + 1}" if getattr(
+                                         kid, "start_mark", None) else "") + ")")
+                if id(kid) not in size:
+                    stack.append((kid, False))
             continue
+        open_.discard(key)
         size[key] = 1 + sum(size[id(k)] for k in kids)
         depth[key] = 1 + max((depth[id(k)] for k in kids), default=0)
         if size[key] > MAX_NODES:
