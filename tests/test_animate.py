@@ -42,6 +42,7 @@ def run_frames(mesh, doc, n, feedback, iters=20):
     return c, frames, state.rows
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("feedback", [0.2, 0.0])
 def test_a_240_degree_twist_is_temporally_coherent(feedback):
     """No rotor changes sign between frames, and no vertex jumps further than 1.5x the
@@ -154,6 +155,7 @@ def test_output_pattern_needs_a_frame_field(tmp_path):
     assert r.exit_code == 2 and "frame-number field" in r.output
 
 
+@pytest.mark.slow
 def test_progress_shows_on_a_terminal_and_stays_quiet_in_a_pipe(tmp_path):
     cmd = [sys.executable, "-m", "srarap_cli", "animate", BAR, TWIST, "-o",
            str(tmp_path / "f{:02d}.obj"), "--frames", "5"]

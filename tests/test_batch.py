@@ -2,6 +2,7 @@
 import csv
 import os
 
+import pytest
 import yaml
 from click.testing import CliRunner
 from helpers import ROOT
@@ -74,6 +75,7 @@ def test_bad_manifest_is_invalid_input(tmp_path):
     assert r.exit_code == 4 and "needs mesh, handles and output" in r.stderr
 
 
+@pytest.mark.slow
 def test_a_dask_cluster_gives_the_same_results_as_local_workers(tmp_path):
     from distributed import LocalCluster
 
@@ -96,6 +98,7 @@ def test_a_dask_cluster_gives_the_same_results_as_local_workers(tmp_path):
         assert remote_rows[n]["iterations"] == local_rows[n]["iterations"]
 
 
+@pytest.mark.slow
 def test_scheduler_local_starts_single_threaded_workers_without_dasks_trim_setting(tmp_path):
     """``--scheduler local``: the same bytes as local workers; its workers run one BLAS
     thread and glibc's own malloc trimming (Dask's nanny default slowed solves 1.8x), without

@@ -98,6 +98,7 @@ def _shell(command, **kwargs):
                           **kwargs)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", [
     "cat {bar} | {srarap} deform /dev/stdin {twist} -o {out} -q",
     "{srarap} deform <(cat {bar}) {twist} -o {out} -q",
@@ -118,6 +119,7 @@ def test_streams_under_any_name_are_read_by_their_content(how, tmp_path):
         assert "not a mesh" in err
 
 
+@pytest.mark.slow
 def test_garbage_on_standard_input_is_refused_before_it_is_spooled(tmp_path, monkeypatch):
     """Refused from its first kilobytes: nothing is written to the temporary folder (a
     stream that never ends would otherwise fill it)."""
@@ -144,6 +146,7 @@ def test_a_stream_larger_than_the_temporary_folder_can_keep_is_refused(monkeypat
         stream.read_mesh_stream(Endless(), name="pipe")
 
 
+@pytest.mark.slow
 def test_devices_are_written_through_as_outputs(tmp_path):
     p = subprocess.run([sys.executable, "-m", "srarap_cli", "compare", BAR, BAR,
                         "--json", "/dev/stdout", "--junit", "/dev/null", "-q"],
@@ -377,6 +380,7 @@ def test_a_sigint_as_a_job_commits_reports_it_done(tmp_path, monkeypatch):
 
 
 
+@pytest.mark.slow
 def test_a_signal_as_a_local_dask_cluster_starts_leaves_nothing_running(tmp_path):
     """A SIGINT while LocalCluster starts its workers: the cluster object never existed to
     be closed, and the fork server waited forever for the workers it had forked (seen at

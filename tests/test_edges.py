@@ -111,6 +111,7 @@ def test_dev_stdout_is_written_through_with_a_format(case):
 
 # --- closed standard descriptors ---------------------------------------------------------
 
+@pytest.mark.slow
 @settings(max_examples=max(BUDGET // 40, 8), deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(closed=st.sets(st.sampled_from([0, 1, 2]), min_size=1),
@@ -346,6 +347,7 @@ main()
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_a_signal_as_a_worker_starts_is_one_line_and_its_code(slow_batch, tmp_path, signum):
     """Workers start with SIGINT/SIGTERM held back until they have their own handlers: a
@@ -375,6 +377,7 @@ batch.commit_files = commit_files
 """
 
 
+@pytest.mark.slow
 def test_a_second_signal_while_a_stopped_batch_writes_its_summary_keeps_the_summary(
         slow_batch, tmp_path):
     (tmp_path / "sitecustomize.py").write_text(SECOND_SIGNAL_AT_THE_SUMMARY)
@@ -413,6 +416,7 @@ main()
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_a_signal_as_the_fork_server_starts_is_one_line_and_its_code(slow_batch, signum):
     """The fork server that starts a local Dask cluster's workers starts with SIGINT/SIGTERM
@@ -428,6 +432,7 @@ def test_a_signal_as_the_fork_server_starts_is_one_line_and_its_code(slow_batch,
 
 # --- a signal at any moment of a run's start and end -------------------------------------
 
+@pytest.mark.slow
 @settings(max_examples=max(BUDGET // 4, 10), deadline=None, phases=[Phase.generate],
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(signum=st.sampled_from([signal.SIGINT, signal.SIGTERM]), delay=st.floats(0.0, 1.5))

@@ -18,6 +18,7 @@ def run(cmd, cwd, **kwargs):
                           **kwargs)
 
 
+@pytest.mark.slow
 def test_the_makefile_pipeline_builds_checks_and_catches_drift(tmp_path):
     if shutil.which("make") is None:
         pytest.skip("make is not installed")
@@ -40,6 +41,7 @@ def workflow_steps():
     return [s for s in flow["jobs"]["regression"]["steps"] if "run" in s]
 
 
+@pytest.mark.slow
 def test_the_ci_workflow_passes_and_fails_on_drift(tmp_path):
     """The workflow's run steps in order, as GitHub runs them (bash -e), except the install
     step: srarap is installed here already. It publishes what its later steps upload."""
@@ -68,6 +70,7 @@ def test_the_ci_workflow_passes_and_fails_on_drift(tmp_path):
     assert '<failure type="regressed"' in (tmp_path / "out" / "junit.xml").read_text()
 
 
+@pytest.mark.slow
 def test_the_api_script_deforms_a_trimesh_mesh(tmp_path):
     pytest.importorskip("trimesh")
     assert run(["srarap", "samples", "samples", "-q"], tmp_path).returncode == 0
@@ -79,6 +82,7 @@ def test_the_api_script_deforms_a_trimesh_mesh(tmp_path):
     assert len(read_mesh(str(tmp_path / "spot-nod.ply")).vertices) == 11533
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", [["--workers", "2"], ["--scheduler", "local", "--workers", "2"]])
 def test_the_batch_manifest_runs_locally_and_on_dask(tmp_path, how):
     if "--scheduler" in how:

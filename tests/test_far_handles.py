@@ -48,6 +48,7 @@ def test_a_far_handle_converges_within_the_default_budget(far):
     assert np.isfinite(r.positions).all()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("far", [300.0, 1e3])
 def test_a_handle_hundreds_of_diagonals_away_says_what_it_reached(far):
     """Between about 30 and 1000 diagonals the fixed point of the linearized local/global map

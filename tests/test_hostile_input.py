@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 import pytest
-from helpers import tube_mesh
+from helpers import run_cli, tube_mesh
 
 from srarap_cli.io.handles import load_handles
 from srarap_cli.io.mesh import read_mesh, write_mesh
@@ -214,8 +214,7 @@ def test_bad_input_is_one_line_with_the_documented_code(tmp_path, args, files, c
     (tmp_path / "folder.obj").mkdir()
     for name, text in files.items():
         (tmp_path / name).write_text(text)
-    p = subprocess.run([sys.executable, "-m", "srarap_cli", *args], cwd=tmp_path,
-                       capture_output=True, text=True, timeout=120)
+    p = run_cli(args, cwd=tmp_path)
     assert p.returncode == code, p.stderr
     assert p.stderr.startswith("srarap: error: ") and p.stderr.count("\n") == 1, p.stderr
     assert message in p.stderr and p.stdout == ""
@@ -294,6 +293,7 @@ def test_the_library_solves_with_one_blas_thread():
     assert seen and set(seen) == {1}
 
 
+@pytest.mark.slow
 def test_a_job_with_a_hostile_handle_file_fails_alone(tmp_path):
     write_mesh(str(tmp_path / "m.obj"), tube_mesh(rings=3, segments=4))
     (tmp_path / "h.yaml").write_text(HANDLES)

@@ -39,6 +39,7 @@ def test_large_mesh_back_end_gives_the_same_deformation(monkeypatch):
     assert np.abs(small.positions - large.positions).max() < 1e-7  # 1.4e-8 measured
 
 
+@pytest.mark.slow
 def test_nested_dissection_back_end_is_deterministic_across_processes():
     """Outputs must be byte-identical run to run: METIS's ordering is seeded, so two fresh
     interpreters factor and solve alike."""

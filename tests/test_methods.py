@@ -53,6 +53,7 @@ def test_relaxation_and_symmetric_linear_step_reach_the_same_minimum():
     assert np.linalg.norm(a.positions - b.positions, axis=1).max() < 1e-2 * DIAG
 
 
+@pytest.mark.slow
 def test_paper_step_ends_above_the_total_energy_minimum():
     a = deform(V, F, IDS, bent(), method="sr-linear", max_iter=5000, tol=1e-12)
     b = deform(V, F, IDS, bent(), method="sr-relax", sweeps=30, max_iter=5000, tol=1e-12)

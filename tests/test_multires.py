@@ -284,6 +284,7 @@ def test_one_fine_factorization_serves_transfer_and_final_solve_for_every_pose(
     assert len(built) == factorizations
 
 
+@pytest.mark.slow
 def test_the_summary_counts_what_the_log_holds_and_reports_wall_seconds(tmp_path):
     """Full-resolution and coarse iterations apart, each equal to the log's rows of its kind;
     the seconds are the wall time of the solve (stages overlap and are not added)."""
@@ -369,6 +370,7 @@ def _slow_full_resolution_prepare(monkeypatch, n, before):
     monkeypatch.setattr(Deformer, "prepare", prepare)
 
 
+@pytest.mark.slow
 def test_the_coarse_solve_runs_while_the_full_resolution_factorization_finishes(spot,
                                                                                 monkeypatch):
     import threading
@@ -408,6 +410,7 @@ def test_a_failed_full_resolution_factorization_is_raised_by_the_solve(spot, mon
         d.solve(p.targets)
 
 
+@pytest.mark.slow
 def test_a_failed_coarse_solve_leaves_no_factorization_running(spot, monkeypatch):
     # a batch worker's next job must not share its core with the last one's leftovers
     import time

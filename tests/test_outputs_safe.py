@@ -7,7 +7,7 @@ import sys
 
 import pytest
 from click.testing import CliRunner
-from helpers import tube_mesh
+from helpers import run_cli, tube_mesh
 
 from srarap_cli.cli import main
 from srarap_cli.io.mesh import write_mesh
@@ -42,8 +42,7 @@ def folder(tmp_path):
 
 
 def _run(folder, *args):
-    return subprocess.run([sys.executable, "-m", "srarap_cli", *args], cwd=folder,
-                          capture_output=True, text=True, timeout=120)
+    return run_cli(args, cwd=folder)
 
 
 def _snapshot(folder):

@@ -4,6 +4,7 @@ import re
 import tomllib
 from importlib.metadata import version
 
+import pytest
 from click.testing import CliRunner
 from helpers import ROOT
 
@@ -24,6 +25,7 @@ def test_requires_python_is_what_the_pinned_dependencies_need():
     assert os.path.exists(os.path.join(ROOT, "srarap_cli", "py.typed"))
 
 
+@pytest.mark.slow
 def test_samples_copies_the_package_data_and_refuses_to_overwrite(tmp_path):
     runner = CliRunner()
     r = runner.invoke(main, ["samples", str(tmp_path / "demo")])

@@ -22,6 +22,7 @@ def folder(tmp_path):
     return tmp_path
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("make") is None, reason="GNU make is not installed")
 def test_make_fails_on_an_unconverged_run_and_fails_again_on_the_rerun(folder):
     srarap = f"{sys.executable} -m srarap_cli"
@@ -60,6 +61,7 @@ def batch(folder, settings, *extra):
     return p.returncode, rows[0]["status"]
 
 
+@pytest.mark.slow
 def test_batch_remembers_a_job_that_did_not_converge(folder):
     assert batch(folder, "{max_iter: 2}") == (3, "not-converged")
     assert not (folder / "out" / "a.obj").exists()  # exit 3 writes no mesh, as deform
@@ -71,6 +73,7 @@ def test_batch_remembers_a_job_that_did_not_converge(folder):
     assert batch(folder, "{max_iter: 1000}") == (0, "up-to-date")
 
 
+@pytest.mark.slow
 def test_the_shipped_batch_example_passes_as_written(tmp_path):
     path = os.path.join(ROOT, "configs", "example-jobs.yaml")
     p = subprocess.run([sys.executable, "-m", "srarap_cli", "batch", path, "-o",
@@ -80,6 +83,7 @@ def test_the_shipped_batch_example_passes_as_written(tmp_path):
     assert [r["status"] for r in rows] == ["ok"] * len(rows)
 
 
+@pytest.mark.slow
 def test_standard_input_and_output_with_formats(folder):
     ref = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "m.obj", "h.yaml", "-o",
                           "ref.obj", "-q"], cwd=folder, capture_output=True, timeout=300)

@@ -18,6 +18,7 @@ def _srarap(*args, stdin=None):
                           capture_output=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_standard_output_takes_the_inputs_format_without_format(tmp_path):
     p = _srarap("deform", BAR, TWIST, "-o", "-")
     assert p.returncode == 0 and p.stdout.startswith(b"# written by srarap\nv ")
@@ -52,6 +53,7 @@ def test_ascii_applies_to_ply_only(tmp_path):
     assert p.returncode == 2 and b"--ascii applies to PLY" in p.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("args", [
     ["info", "-", "--input-format", "obj"],
     ["compare", "-", BAR, "--input-format", "obj"],

@@ -41,6 +41,7 @@ def test_the_complete_handle_example_is_the_shipped_one_and_runs_as_pasted(tmp_p
     assert np.allclose(moved[c.ids], c.targets, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_the_tour_runs_as_written(tmp_path):
     """Every block of the README's tour, in order, in an empty folder (Python blocks through
     the same interpreter), must succeed."""
@@ -121,6 +122,7 @@ def test_the_guides_make_rule_builds_its_target_and_then_has_nothing_to_do(tmp_p
     assert "up to date" in again.stdout
 
 
+@pytest.mark.slow
 def test_the_python_guide_runs_as_written(tmp_path):
     """Its blocks in order, in one interpreter, in a folder holding the samples."""
     import subprocess
@@ -138,6 +140,7 @@ def test_the_python_guide_runs_as_written(tmp_path):
     assert p.stdout.splitlines()[-1].startswith("True")
 
 
+@pytest.mark.slow
 def test_the_guides_dask_worker_command_serves_a_batch(tmp_path):
     """The worker command as written (host and port filled in) joins a scheduler, and a batch
     of the guide's manifest runs on it."""

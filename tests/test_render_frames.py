@@ -35,6 +35,7 @@ def red_pixels(img):
     return np.abs(rgb - np.array(PALETTE[0][:3])).max(axis=2) < 0.3
 
 
+@pytest.mark.slow
 def test_a_gif_holds_every_frame_framed_alike_and_is_reproducible(frames, tmp_path):
     a, b = tmp_path / "a.gif", tmp_path / "b.gif"
     assert render(frames, "--handles", TWIST, "-o", a, "--size", "200x300").exit_code == 0

@@ -85,6 +85,7 @@ def test_the_report_is_self_contained(run):
     assert not re.search(r'(src|href)="(?!data:|#)', html)  # nothing fetched from anywhere
 
 
+@pytest.mark.slow
 def test_two_runs_on_identical_inputs_differ_only_in_the_seconds(tmp_path):
     path = manifest(tmp_path)
     texts = []

@@ -46,6 +46,7 @@ def _wait_for(folder, name, timeout=60):
         time.sleep(0.02)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated"),
                                              (signal.SIGINT, 130, "interrupted")])
 def test_a_signal_while_the_process_ends_still_gives_its_code_and_the_truth(case, sig, code,
@@ -125,6 +126,7 @@ def big(case):
     return case
 
 
+@pytest.mark.slow
 def test_the_memory_guard_takes_the_address_space_limit(big):
     p = _run_limited(big, 600_000_000, None, "deform", "big.obj", "h.yaml", "-o", "o.obj",
                      "--multires", "off")
@@ -132,6 +134,7 @@ def test_the_memory_guard_takes_the_address_space_limit(big):
     assert "GB of memory" in p.stderr and "ulimit -v" in p.stderr and p.stderr.count("\n") == 1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("limit", [600_000_000, 750_000_000])
 def test_running_out_of_memory_is_exit_4_and_one_line(big, limit):
     """The guard told to assume plenty: the allocation fails for real, somewhere in numpy,
@@ -144,6 +147,7 @@ def test_running_out_of_memory_is_exit_4_and_one_line(big, limit):
     assert (big / "o.obj").read_text() == "old result\n"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("value", ["inf", "1e400", "99999999999999999999", "-5", "nan", "x"])
 def test_an_unusable_memory_limit_setting_is_invalid_input(case, value):
     p = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "m.obj", "h.yaml", "-o",

@@ -11,6 +11,7 @@ from helpers import ROOT
 from srarap_cli.tasks.worker_pool import death_note, run_in_processes
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("workers", [1, 2, 3])
 def test_a_job_that_kills_its_worker_fails_alone_and_the_others_finish(tmp_path, workers):
     names = ["a", "b", "kill", "c", "d", "e"]
@@ -50,6 +51,7 @@ batch.run_job = run_job
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("extra", [[], ["--scheduler", "local"]])
 def test_a_batch_whose_worker_is_killed_reports_that_job_failed_and_the_rest(tmp_path, extra):
     """Local worker processes, or a local Dask cluster (whose task for the job fails once
