@@ -15,6 +15,7 @@ from ..io.mesh.formats import extensions
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
+from ..runtime.encoding import utf8
 from ..runtime.errors import InputError, OutputError
 from ..runtime.limits import check_solve
 from ..solver.settings import resolve
@@ -22,7 +23,7 @@ from ..solver.stop import StopReason
 from ..tasks.animation import FRAME_FIELDS, Animator, FrameState, fingerprint, unreached_keys
 from ..tasks.pipeline import refuse_warnings
 from ..tasks.preflight import check_output_path, refuse_overwrite
-from .common import cache_option, finite_option, guarded, report, with_verbosity
+from .common import FiniteFloat, cache_option, guarded, report, with_verbosity
 from .options import settings_options
 
 STATE_NAME = ".srarap-animate-state.npz"
@@ -36,7 +37,7 @@ MAX_FRAMES = 100_000
               help="Frame file pattern with a format field, e.g. 'out/frame_{:04d}.obj'.")
 @click.option("--frames", type=click.IntRange(min=1),
               help="Number of frames. [default: up to the last keyframe]")
-@click.option("--fps", type=click.FloatRange(min=0, min_open=True), callback=finite_option,
+@click.option("--fps", type=FiniteFloat(min=0, min_open=True),
               help="Frames per second, for keyframes given by time.")
 @click.option("--max-frames", type=click.IntRange(min=1), default=MAX_FRAMES, show_default=True,
               help="Refuse an animation of more frames than this (a typo in --fps or a "
@@ -107,7 +108,7 @@ def animate(mesh: str, handles: str, pattern: str, frames: int | None, fps: floa
         rows = rows + [animator.stopped_row]
     if log is not None:
         text = format_log(rows, os.path.splitext(log)[1].lower(), FRAME_FIELDS)
-        commit_files([(log, text.encode())])
+        commit_files([(log, utf8(text))])
     stopped = animator.stopped_at
     if stopped is None and os.path.exists(state_path):
         os.unlink(state_path)

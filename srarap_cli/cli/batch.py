@@ -9,6 +9,7 @@ import click
 
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
+from ..runtime.encoding import utf8
 from ..runtime.errors import OutputError
 from ..runtime.signals import Terminated, block
 from ..tasks.batch import run_batch
@@ -17,7 +18,7 @@ from ..tasks.job_status import SUMMARY_FIELDS, WARNING_JOIN, JobStatus
 from ..tasks.manifest import check_outputs, load_manifest
 from ..tasks.preflight import check_output_path
 from ..tasks.report import junit_xml, report_html
-from .common import guarded
+from .common import guarded, say
 
 #: a Dask scheduler address: protocol://host:port, or host:port
 SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
@@ -72,18 +73,14 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         # the summary is what is left to do: a second Ctrl-C or SIGTERM (a CI runner's
         # timeout sends more than one) must not cost it; the exit code says stopped anyway
         block()
-    pictures = {r.job: r.pictures for r in rows}
     summary_rows = [r.row() for r in rows]
-    files = [(os.path.join(out, "summary.csv"), _csv(summary_rows).encode()),
-             (os.path.join(out, "summary.json"),
-              (json.dumps(summary_rows, indent=2) + "\n").encode())]
-    title = os.path.splitext(os.path.basename(manifest))[0]
-    if report is not None:
-        files.append((report, report_html(rows, pictures, f"srarap batch: {title}").encode()))
-    if junit is not None:
-        files.append((junit, junit_xml(rows, title).encode()))
-    commit_files(files)
+    # the summary first, on its own: a report that cannot be written (a full disk) must not
+    # cost the account of the jobs whose outputs are on disk
+    commit_files([(os.path.join(out, "summary.csv"), utf8(_csv(summary_rows))),
+                  (os.path.join(out, "summary.json"),
+                   utf8(json.dumps(summary_rows, indent=2) + "\n"))])
     _tell(rows, out, quiet, stopped)
+    _write_reports(rows, manifest, report, junit)
     if stopped is not None:
         raise SystemExit(exit_codes.TERMINATED if isinstance(stopped, Terminated)
                          else exit_codes.INTERRUPTED)
@@ -91,6 +88,18 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         raise SystemExit(exit_codes.BATCH_FAILED)
     if any(r.status is JobStatus.NOT_CONVERGED for r in rows):
         raise SystemExit(exit_codes.NOT_CONVERGED)
+
+
+def _write_reports(rows, manifest, report, junit):
+    """The HTML report and the JUnit file, committed together."""
+    title = os.path.splitext(os.path.basename(manifest))[0]
+    files = []
+    if report is not None:
+        pictures = {r.job: r.pictures for r in rows}
+        files.append((report, utf8(report_html(rows, pictures, f"srarap batch: {title}"))))
+    if junit is not None:
+        files.append((junit, utf8(junit_xml(rows, title))))
+    commit_files(files)
 
 
 def _tell(rows, out, quiet, stopped):
@@ -103,8 +112,7 @@ def _tell(rows, out, quiet, stopped):
         warned = f"  {len(r.warnings)} warning(s)" if r.warnings else ""
         extra = f"  {printable(r.message)}" if r.message else ""
         seconds = "" if r.seconds is None else f"{r.seconds:8.2f} s"
-        click.echo(f"{printable(r.job):24} {r.status.value:13} {seconds:>10}{warned}{extra}",
-                   err=True)
+        say(f"{printable(r.job):24} {r.status.value:13} {seconds:>10}{warned}{extra}")
     summary = ", ".join(f"{v} {k.value}" for k, v in counts.items() if v)
     warned = sum(bool(r.warnings) for r in rows)
     if warned:
@@ -115,7 +123,7 @@ def _tell(rows, out, quiet, stopped):
         word = "terminated" if isinstance(stopped, Terminated) else "interrupted"
         note = (f"; {word}: the jobs not finished are marked interrupted in "
                 f"{os.path.join(out, 'summary.csv')}")
-    click.echo(f"srarap batch: {len(rows)} jobs: {summary}{note}", err=True)
+    say(f"srarap batch: {len(rows)} jobs: {summary}{note}")
 
 
 def printable(text: str) -> str:

@@ -7,6 +7,7 @@ import click
 from ..io.handles import load_handles
 from ..io.mesh import read_mesh
 from ..runtime.commit import commit_files
+from ..runtime.encoding import utf8
 from ..runtime.errors import OutputError
 from ..runtime.limits import check_solve
 from ..solver.settings import resolve
@@ -14,7 +15,7 @@ from ..tasks.bench import ALL_METHODS, IGL, run_methods
 from ..tasks.bench_report import curves_csv, plot_png, summary_json, table
 from ..tasks.pipeline import problem
 from ..tasks.preflight import refuse_overwrite
-from .common import guarded
+from .common import FiniteFloat, guarded, write_stdout
 from .options import settings_options
 
 CHOICES = ALL_METHODS + (IGL,)
@@ -29,7 +30,7 @@ BENCH_FILES = ("curves.csv", "summary.json", "energy.png")
 @click.argument("handles")
 @click.option("--methods", default=",".join(CHOICES), show_default=True,
               help=f"Comma-separated, from: {', '.join(CHOICES)}.")
-@click.option("--time-budget", type=click.FloatRange(min=0, min_open=True), default=30.0,
+@click.option("--time-budget", type=FiniteFloat(min=0, min_open=True), default=30.0,
               show_default=True, help="Seconds each method may run.")
 @click.option("-o", "--output", "out",
               help="Folder for curves.csv, summary.json and energy.png (created if missing).")
@@ -61,13 +62,13 @@ def bench(mesh: str, handles: str, methods: str, time_budget: float, out: str | 
     p = problem(source, constraints, mesh)
     runs = run_methods(p.V, p.F, p.ids, p.targets, names, settings=opts,
                        time_budget=time_budget)
-    click.echo(table(runs), nl=False)
+    write_stdout(utf8(table(runs)))
     if out is not None:
         info = {"mesh": mesh, "handles": handles, "vertices": len(p.V),
                 "constrained": len(p.ids), "time_budget": time_budget,
                 **{k: getattr(opts, k) for k in ("alpha", "feedback", "weights", "sweeps")}}
         title = f"{os.path.basename(mesh)} ({len(p.V)} vertices)"
-        payloads = (curves_csv(runs).encode(), summary_json(runs, info).encode(),
+        payloads = (utf8(curves_csv(runs)), utf8(summary_json(runs, info)),
                     plot_png(runs, title))
         commit_files([(os.path.join(out, name), data)
                       for name, data in zip(BENCH_FILES, payloads)])

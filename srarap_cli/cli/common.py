@@ -32,6 +32,16 @@ def fail(code: int, message: str) -> NoReturn:
     sys.exit(code)
 
 
+def say(text: str) -> None:
+    """One line on standard error: a summary, a warning, a table row. A standard error that
+    cannot take it (a full device, a closed pipe) loses the line, not the run, whose
+    outputs and exit code stand."""
+    try:
+        click.echo(text, err=True)
+    except OSError:
+        pass
+
+
 def write_stdout(data: bytes) -> None:
     """``data`` (bytes) to standard output; a full device or a closed pipe is an output error
     and a broken pipe respectively, never an internal one."""
@@ -129,20 +139,24 @@ def report(verbosity: int | None, *, warnings: Sequence[str] = (), details: Sequ
     it came up), the detail lines with ``-v``, the summary line unless ``-q``."""
     counts = Counter(warnings)
     for text, n in counts.items():
-        click.echo(f"srarap: warning: {text}" + (f" ({n} times)" if n > 1 else ""), err=True)
+        say(f"srarap: warning: {text}" + (f" ({n} times)" if n > 1 else ""))
     if verbosity is not None and verbosity >= 2:
         for line in details:
-            click.echo(line, err=True)
+            say(line)
     if summary is not None and (verbosity is None or verbosity >= 1):
-        click.echo(summary, err=True)
+        say(summary)
 
 
-def finite_option(_ctx: click.Context, _param: click.Parameter,
-                  value: float | None) -> float | None:
-    """Click callback: a float option must be finite (FloatRange lets inf through)."""
-    if value is not None and not math.isfinite(value):
-        raise click.BadParameter("must be a finite number")
-    return value
+class FiniteFloat(click.FloatRange):
+    """A float option's type: in its range and finite (Click's FloatRange lets NaN through
+    every bound, and infinity through an open one)."""
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        out = super().convert(value, param, ctx)
+        if out is not None and not math.isfinite(out):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        return out
 
 
 class MeshFormatType(click.ParamType):
@@ -172,12 +186,10 @@ input_format_option = click.option(
 
 def pose_options(func: Callable[..., None]) -> Callable[..., None]:
     """``--fps`` and ``--frame``: which pose of a keyframed handle file a single solve takes."""
-    func = click.option("--frame", type=click.FloatRange(min=0), default=0.0, show_default=True,
-                        callback=finite_option,
+    func = click.option("--frame", type=FiniteFloat(min=0), default=0.0, show_default=True,
                         help="Pose of keyframed groups at this frame (fractional frames "
                              "interpolate).")(func)
-    return click.option("--fps", type=click.FloatRange(min=0, min_open=True),
-                        callback=finite_option,
+    return click.option("--fps", type=FiniteFloat(min=0, min_open=True),
                         help="Frames per second, for keyframes given by time (needed with "
                              "--frame unless every key gives its frame).")(func)
 

@@ -6,18 +6,19 @@ import click
 from ..io.mesh.formats import MeshFormat
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
+from ..runtime.encoding import utf8
 from ..tasks.compare import beyond, compare_meshes
 from ..tasks.job_pictures import compare_pictures
 from ..tasks.job_status import JobResult, JobStatus
 from ..tasks.preflight import check_output_path, read_any_mesh, refuse_overwrite
 from ..tasks.report import junit_xml, report_html
-from .common import guarded, input_format_option
+from .common import FiniteFloat, guarded, input_format_option, say
 
 
 @click.command("compare")
 @click.argument("a")
 @click.argument("b")
-@click.option("--tol", type=click.FloatRange(min=0), default=0.0, show_default=True,
+@click.option("--tol", type=FiniteFloat(min=0), default=0.0, show_default=True,
               help="Largest allowed distance (model units, or a fraction with --relative).")
 @click.option("--relative", is_flag=True,
               help="Distances as fractions of A's bounding-box diagonal.")
@@ -53,7 +54,7 @@ def compare(a: str, b: str, tol: float, relative: bool, report: str | None,
     result = {"a": a, "b": b, "mode": figures["mode"], "relative": relative, "tol": tol,
               "within_tol": within, **shown, "diagonal": figures["diagonal"],
               "farthest": figures["where"], "beyond_tol": beyond(figures, tol, relative)}
-    files = [] if report is None else [(report, (json.dumps(result, indent=2) + "\n").encode())]
+    files = [] if report is None else [(report, utf8(json.dumps(result, indent=2) + "\n"))]
     if html_report is not None or junit is not None:
         status = JobStatus.OK if within else JobStatus.REGRESSED
         row = JobResult(f"{a} vs {b}", status, status.exit_code, compare_max=shown["max"],
@@ -61,16 +62,16 @@ def compare(a: str, b: str, tol: float, relative: bool, report: str | None,
                         f"max distance {shown['max']:.3g} > tol {tol:g}{_where(result)}")
         if html_report is not None:
             pictures = compare_pictures(ma, mb, figures, tol, scale)
-            files.append((html_report, report_html([row], {row.job: pictures},
-                                                   "srarap compare").encode()))
+            files.append((html_report, utf8(report_html([row], {row.job: pictures},
+                                                        "srarap compare"))))
         if junit is not None:
-            files.append((junit, junit_xml([row], "compare").encode()))
+            files.append((junit, utf8(junit_xml([row], "compare"))))
     commit_files(files)
     if not quiet:
         unit = " of the diagonal" if relative else ""
-        click.echo(f"srarap compare: {'within' if within else 'BEYOND'} tol {tol:g}{unit} "
+        say(f"srarap compare: {'within' if within else 'BEYOND'} tol {tol:g}{unit} "
                    f"({figures['mode']}): max {shown['max']:.6g}, mean {shown['mean']:.6g}, "
-                   f"rms {shown['rms']:.6g}{unit}{_where(result)}", err=True)
+                   f"rms {shown['rms']:.6g}{unit}{_where(result)}")
     if not within:
         raise SystemExit(exit_codes.BEYOND_TOLERANCE)
 

@@ -4,9 +4,10 @@ import json
 import click
 
 from ..io.mesh.formats import MeshFormat
+from ..runtime.encoding import utf8
 from ..tasks.info import handles_info, mesh_info
 from ..tasks.preflight import load_posed, read_any_mesh
-from .common import guarded, input_format_option, pose_options
+from .common import guarded, input_format_option, pose_options, write_stdout
 
 
 @click.command("info")
@@ -30,9 +31,9 @@ def info(mesh: str, handles: str | None, input_format: MeshFormat | None,
         out["handles"] = handles
         out.update(handles_info(source, load_posed(handles, source.vertices, fps, frame), name))
     if as_json:
-        click.echo(json.dumps(out, indent=2))
+        write_stdout(utf8(json.dumps(out, indent=2) + "\n"))
     else:
-        click.echo(_text(out))
+        write_stdout(utf8(_text(out) + "\n"))
 
 
 def _text(d):

@@ -11,7 +11,7 @@ import click
 
 from ..solver.multires.size import parse_size
 from ..solver.settings import SETTINGS, Setting
-from .common import finite_option
+from .common import FiniteFloat
 
 #: a command function a decorator wraps
 F = TypeVar("F", bound=Callable[..., Any])
@@ -25,19 +25,19 @@ def setting_option(setting: Setting, default: object = None) -> Callable[[F], F]
     if setting.kind == "flag":
         return click.option(setting.flag, setting.name, is_flag=True, default=None,
                             help=f"{setting.help} [default: off]")
+    kind: click.ParamType
     if setting.kind == "choice":
-        kind, callback = click.Choice(setting.choices), None
+        kind = click.Choice(setting.choices)
     elif setting.kind == "size":
         return click.option(setting.flag, callback=_size_option, metavar=setting.metavar,
                             help=text)
     elif setting.kind == "int":
         low = None if setting.minimum is None else int(setting.minimum)
-        kind, callback = click.IntRange(min=low, min_open=setting.strict), None
+        kind = click.IntRange(min=low, min_open=setting.strict)
     else:
-        kind = click.FloatRange(min=setting.minimum, min_open=setting.strict)
-        callback = finite_option
+        kind = FiniteFloat(min=setting.minimum, min_open=setting.strict)
     return click.option(setting.flag, setting.name, type=kind, metavar=setting.metavar,
-                        help=text, callback=callback)
+                        help=text)
 
 
 def _size_option(_ctx, _param, value):

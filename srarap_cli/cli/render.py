@@ -18,7 +18,7 @@ from ..tasks.log_axis import decades_axis
 from ..tasks.preflight import check_output_path, read_any_mesh, refuse_overwrite
 from ..tasks.preview import preview_png
 from ..tasks.render import VIEWS
-from .common import guarded, input_format_option
+from .common import FiniteFloat, guarded, input_format_option
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -52,7 +52,7 @@ def parse_size(text: str) -> tuple[int, int]:
                    "several views side by side.")
 @click.option("--size", help="WIDTHxHEIGHT in pixels (of each frame, for a frame pattern). "
                                 "[default: 800x600; 480x360 a frame]")
-@click.option("--fps", type=click.FloatRange(min=1, max=50), default=12.0, show_default=True,
+@click.option("--fps", type=FiniteFloat(min=1, max=50), default=12.0, show_default=True,
               help="Frames per second of an animated GIF.")
 @input_format_option
 @guarded

@@ -6,7 +6,7 @@ import click
 
 from ..runtime.commit import commit_files
 from ..runtime.errors import OutputError
-from .common import guarded
+from .common import guarded, say
 
 #: what is copied: meshes, handle files and a batch manifest, and the goldens it checks against
 SUBFOLDERS = ("sample_meshes", "configs", "golden")
@@ -49,4 +49,4 @@ def samples(folder: str, force: bool, quiet: bool) -> None:
                               f"{exc.strerror}") from None
     commit_files(files)
     if not quiet:
-        click.echo(f"srarap samples: wrote {len(files)} files to {folder}", err=True)
+        say(f"srarap samples: wrote {len(files)} files to {folder}")

@@ -45,7 +45,7 @@ def commit_files(files: list[tuple[str, bytes]]) -> None:
             if _writes_through(path):
                 through.append((path, data))
             else:
-                target = os.path.realpath(path) if os.path.islink(path) else path
+                target = _link_target(path) if os.path.islink(path) else path
                 staged.append((_named(path, _stage, target, data), target))
         for path, data in through:
             _named(path, _write_through, path, data)
@@ -104,6 +104,19 @@ def _replace_all(staged):
     COMMITTED.extend(path for _, path in staged)
     for _, kept in done:
         _remove(kept)
+
+
+def _link_target(path):
+    """Where the symbolic link ``path`` leads (the file to replace); a link that leads
+    nowhere it can end (a loop) is an output error, as the shell's ELOOP: replacing the
+    link with a file would write where the user did not ask."""
+    try:
+        return os.path.realpath(path, strict=True)
+    except FileNotFoundError:  # a dangling link: its target is made
+        return os.path.realpath(path)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write: {exc.strerror or exc} (a symbolic link "
+                          "that leads back to itself)") from None
 
 
 def _writes_through(path):

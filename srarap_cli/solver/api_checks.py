@@ -5,6 +5,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..runtime.limits import MAX_COORDINATE
+
 
 def mesh_arrays(V: ArrayLike, F: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """``V`` as an (n, 3) finite float array and ``F`` as an (f, 3) int array indexing it.
@@ -21,6 +23,10 @@ def mesh_arrays(V: ArrayLike, F: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"V must be an (n, 3) array of vertex positions, got shape {V.shape}")
     if not np.isfinite(V).all():
         raise ValueError("V has NaN or infinite coordinates")
+    huge = np.abs(V).max(axis=1) > MAX_COORDINATE
+    if huge.any():
+        raise ValueError(f"V: vertex {int(np.flatnonzero(huge)[0])} has a coordinate beyond "
+                         f"{MAX_COORDINATE:g} (its square would overflow); rescale the mesh")
     F = _array(F, "F")
     if F.ndim != 2 or F.shape[1] != 3 or not len(F):
         raise ValueError(f"F must be an (f, 3) array of triangles, got shape {F.shape}")
@@ -29,6 +35,36 @@ def mesh_arrays(V: ArrayLike, F: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
             raise ValueError(f"F must hold integer vertex indices, got dtype {F.dtype}")
     _in_range(F, len(V), "F")
     return V, F.astype(np.int64, copy=False)  # no copy of an int64 F: 35 MB at 738k vertices
+
+
+def positive(value: Any, name: str) -> float:
+    """``value`` as a finite float > 0 (an area, a scale).
+
+    Examples
+    --------
+    >>> positive(0, "area")
+    Traceback (most recent call last):
+    ...
+    ValueError: area must be a finite number > 0, got 0
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be a number, got {type(value).__name__}")
+    if not (np.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    return float(value)
+
+
+def labels(values: ArrayLike, k: int) -> np.ndarray:
+    """Group labels of the ``k`` constrained vertices as a (k,) int array of labels >= 0."""
+    out = _array(values, "labels")
+    if out.ndim != 1 or len(out) != k:
+        raise ValueError(f"labels must be a 1-d array of {k} group labels, one per constrained "
+                         f"vertex, got shape {out.shape}")
+    if out.dtype.kind not in "iu" and not (out.dtype.kind == "f" and np.all(out == np.round(out))):
+        raise TypeError(f"labels must hold integer group labels, got dtype {out.dtype}")
+    if k and out.min() < 0:
+        raise ValueError("labels must be >= 0")
+    return out.astype(np.int64)
 
 
 def _in_range(ids, n, name):

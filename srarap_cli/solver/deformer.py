@@ -22,6 +22,7 @@ from .global_step import PoissonSolver
 from .group_rotations import connected_groups
 from .linear_response import LinearResponse
 from .local_step import METHODS
+from .mesh_checks import geometry_problem
 from .operators import cell_graph
 from .rest_edges import RestEdges
 from .settings import Settings, with_keywords
@@ -193,8 +194,11 @@ class Deformer:
         self.settings = with_keywords(settings, options, ("setup", "solve"), "Deformer")
         s = self.settings
         self.V, self.F = api_checks.mesh_arrays(V, F)
+        why = geometry_problem(self.V, self.F)
+        if why is not None:
+            raise ValueError(f"V, F: {why}")
         self.graph = cell_graph(self.V, self.F, s.weights)
-        self.area = self.graph.area if area is None else float(area)
+        self.area = self.graph.area if area is None else api_checks.positive(area, "area")
         self.constrained = api_checks.vertex_ids(constrained, len(self.V))
         self._mask = np.zeros(len(self.V), dtype=bool)
         self._mask[self.constrained] = True
@@ -205,7 +209,7 @@ class Deformer:
         self.fixed = np.flatnonzero(self._mask)
         self.constrained_slots = np.searchsorted(self.fixed, self.constrained)
         self.labels = (connected_groups(self.graph.laplacian, self.constrained)
-                       if labels is None else np.asarray(labels, dtype=np.int64).ravel())
+                       if labels is None else api_checks.labels(labels, len(self.constrained)))
         self.edges = RestEdges(self.graph, self.V)
         self.energy_scale = max(float(self.graph.c @ self.edges.q_sq), 1e-300)
         self.diagonal = float(np.linalg.norm(np.ptp(self.V, axis=0)))
@@ -343,7 +347,10 @@ class Deformer:
         if initial is not None and start not in WARM_STARTS:
             start = "warm"
         first = STARTS[start](step, initial)
-        run = driver if callable(driver) else DRIVERS[driver or ACCEL_DRIVERS[s.accel]]
+        run = driver if callable(driver) else DRIVERS.get(driver or ACCEL_DRIVERS[s.accel])
+        if run is None:
+            raise ValueError(f"driver {driver!r} is not one of {', '.join(map(repr, DRIVERS))} "
+                             "or a callable")
         state = run(step, first, monitor)
         reason = monitor.reason or StopReason.DRIVER
         return DeformResult(state.positions, state.rotors, monitor.log, reason,

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..runtime.errors import unknown_key
+from ..runtime.numbers import spelled, whole
 from .local_step import METHODS
 from .multires.size import AUTO_RATIO, AUTO_SIZE, AUTO_THRESHOLD, parse_size
 
@@ -74,7 +75,9 @@ class Setting:
             except ValueError as exc:
                 raise error(f"{self.name} {exc}") from None
         out: float
+        value = spelled(value)
         if self.kind == "int":
+            value = whole(value)
             if isinstance(value, bool) or not isinstance(value, int):
                 raise error(f"{self.name} must be an integer")
             out = value

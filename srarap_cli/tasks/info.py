@@ -8,7 +8,7 @@ from ..io.mesh import Mesh
 from ..solver.group_rotations import group_rotors
 from ..solver.mesh_checks import edge_adjacency, edge_counts, mesh_warnings
 from ..solver.operators import triangle_normals
-from ..solver.quaternion import IDENTITY, to_matrix
+from ..solver.quaternion import to_matrix
 from .pipeline import problem
 
 AXES = "xyz"
@@ -67,7 +67,7 @@ def handles_info(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> di
         action = ("keyframed, keys given by time (the pose at frame 0 is checked; --fps "
                   "places the others)" if track is not None and track.first_only else
                   f"keyframed ({len(track.frames)} keys, last at frame {track.frames[-1]:g})"
-                  if track is not None else
+                  if track is not None else constraints.actions.get(g) or
                   describe_motion(mesh.vertices[ids], constraints.targets[slots[g]]))
         groups.append({"name": g, "vertices": int(len(ids)), "action": action})
     n = len(mesh.vertices)
@@ -96,7 +96,15 @@ def describe_motion(rest: np.ndarray, targets: np.ndarray) -> str:
         return "fixed"
     labels = np.zeros(len(rest), np.int64)
     q, determined = group_rotors(rest, targets, labels, 1)
-    q = q[0] if determined.all() else IDENTITY
+    if not determined.all():  # collinear or single vertices: no rotation can be told
+        moved = float(np.linalg.norm(targets - rest, axis=1).max())
+        shift = targets.mean(axis=0) - rest.mean(axis=0)
+        if np.abs(rest + shift - targets).max() <= 1e-9 * max(np.ptp(rest, axis=0).max(),
+                                                              1e-300):
+            return f"translate {_vec(shift)}"
+        return (f"moves its vertices by up to {moved:.6g} (they lie on a line: the rotation "
+                "is not determined by them)")
+    q = q[0]
     q = q if q[0] >= 0 else -q
     angle = float(np.degrees(2 * np.arctan2(np.linalg.norm(q[1:]), q[0])))
     scale = max(np.abs(rest).max(), 1.0)

@@ -17,6 +17,7 @@ from ..io.mesh.formats import MeshFormat, by_extension, extensions
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime import descriptors, memory
 from ..runtime.commit import commit_files
+from ..runtime.encoding import utf8
 from ..runtime.errors import NumericalError, OutputError, UsageProblem
 from ..runtime.failures import classify
 from ..runtime.limits import check_solve
@@ -222,6 +223,6 @@ def _files(job, keep, mesh_bytes, deformed, source, constraints, solve):
         files.append((job.preview, preview_png(deformed, source, constraints, view="iso",
                                                up=up)))
     if job.log is not None:
-        files.append((job.log, format_log(solve.log, os.path.splitext(job.log)[1].lower())
-                      .encode()))
+        files.append((job.log, utf8(format_log(solve.log,
+                                               os.path.splitext(job.log)[1].lower()))))
     return files

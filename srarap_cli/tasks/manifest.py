@@ -21,7 +21,9 @@ def load_manifest(path: str) -> list[Job]:
         raise InputError(f"{path}: a manifest needs a non-empty 'jobs' list")
     base = os.path.dirname(os.path.abspath(path))
     defaults = _settings(path, "defaults", doc.get("defaults", {}))
-    jobs, names, outputs = [], set(), set()
+    jobs: list[Job] = []
+    names: set[str] = set()
+    outputs: set[str] = set()
     for k, job in enumerate(doc["jobs"]):
         where = f"{path}: job {k}"
         if not isinstance(job, dict) or not {"mesh", "handles", "output"} <= set(job):
@@ -32,6 +34,7 @@ def load_manifest(path: str) -> list[Job]:
         output = _output_name(where, job["output"])
         if output in outputs:
             raise InputError(f"{where}: output {output!r} is also another job's output")
+        _refuse_nesting(where, output, outputs)
         outputs.add(output)
         name = str(job.get("name", os.path.splitext(output)[0]))
         if name in names:
@@ -70,6 +73,18 @@ def _output_name(where, value):
     return norm
 
 
+def _refuse_nesting(where, output, outputs):
+    """An output that would be a folder of another's (``x.obj`` and ``x.obj/y.obj``): one of
+    the two jobs could never write."""
+    parts = output.split(os.sep)
+    for other in outputs:
+        theirs = other.split(os.sep)
+        short, long_ = sorted((parts, theirs), key=len)
+        if len(short) < len(long_) and long_[:len(short)] == short:
+            raise InputError(f"{where}: output {output!r} and another job's {other!r}: one "
+                             "would be a folder holding the other")
+
+
 def check_outputs(jobs: list[Job],
                   out_dir: str, manifest: str) -> None:
     """Refuse a run whose outputs (or their sidecars) would land on any job's input or the
@@ -82,10 +97,22 @@ def check_outputs(jobs: list[Job],
                      for path in referenced_files(job["handles"])),
                    *([(f"golden mesh of job {job['name']!r}", job["expect"]["golden"])]
                      if job["expect"] else [])]
+    _stay_inside(jobs, out_dir)
     outputs = [os.path.join(out_dir, name) for job in jobs
                for name in (job["output"], job["output"] + ".srarap.json")]
     outputs += [os.path.join(out_dir, name) for name in ("summary.csv", "summary.json")]
     refuse_overwriting_inputs(outputs, inputs)
+
+
+def _stay_inside(jobs, out_dir):
+    """Refuse an output that a symbolic link inside ``out_dir`` would carry outside it (the
+    names were checked as text when the manifest was read)."""
+    root = os.path.realpath(out_dir)
+    for job in jobs:
+        target = os.path.realpath(os.path.join(out_dir, job["output"]))
+        if os.path.commonpath([root, target]) != root:
+            raise InputError(f"job {job['name']!r}: output {job['output']!r} leads out of the "
+                             f"output folder {out_dir} (through a symbolic link, to {target})")
 
 
 def _settings(where, key, spec):

@@ -20,7 +20,14 @@ from .fields import Context
 from .formats import read_def, read_sel
 from .keys import parse_track
 from .selectors import SELECTOR_KEYS, select
-from .transforms import ACTION_KEYS, check_reach, not_rigid, targets
+from .transforms import (
+    ACTION_KEYS,
+    check_bounds,
+    check_reach,
+    describe_action,
+    not_rigid,
+    targets,
+)
 
 TOP_KEYS = ("groups", "region", "solver")
 ANIMATION_KEYS = ("keyframes", "easing")
@@ -40,6 +47,7 @@ class Constraints:
     solver : dict, solver settings given in the file (see :mod:`srarap_cli.solver.settings`)
     tracks : list of (slots, rest, Track): keyframed groups, ``slots`` indexing ``ids``;
         ``targets`` holds their pose at frame 0
+    actions : dict of group name -> str, each static group's action as the file states it
     warnings : list of str, what the file says that is valid but looks like a mistake (an
         angle's unit, a motion larger than the mesh), each naming file and group
     """
@@ -51,6 +59,7 @@ class Constraints:
     solver: dict = field(default_factory=dict)
     tracks: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
+    actions: dict = field(default_factory=dict)
 
     @property
     def last_key_frame(self) -> float:
@@ -136,7 +145,7 @@ def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = 
     groups = doc.get("groups")
     if not isinstance(groups, dict) or not groups:
         raise ctx.error("'groups' must map at least one group name to its selection and action")
-    names, ids, tgts, tracks = [], [], [], {}
+    names, ids, tgts, tracks, actions = [], [], [], {}, {}
     diagonal = float(np.linalg.norm(np.ptp(V, axis=0))) if len(V) else 0.0
     for name, spec in groups.items():
         gctx = ctx.at(f"group {name!r}")
@@ -147,14 +156,19 @@ def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = 
         if "keyframes" in spec:
             track = tracks[str(name)] = parse_track(gctx, spec, V[sel], fps, any_rate)
             tgts.append(track.apply(V[sel], 0.0))
-            for k, frame in enumerate(track.frames):
-                check_reach(gctx, V[sel], track.apply(V[sel], float(frame)), diagonal,
-                            f"its keyframe {k}")
+            for k, frame in enumerate(track.frames):  # every key checked before frame 0
+                moved = track.apply(V[sel], float(frame))
+                check_bounds(gctx, moved, f"keyframe {k}")
+                check_reach(gctx, V[sel], moved, diagonal, f"its keyframe {k}")
+            if np.abs(track.pivot).max(initial=0) > MAX_COORDINATE:
+                raise gctx.error(f"pivot beyond {MAX_COORDINATE:g}: its keyframes' rotations "
+                                 "would send vertices to infinity between the keys")
         else:
             if "easing" in spec:
                 raise gctx.error("easing only applies together with keyframes")
             tgts.append(targets(gctx, spec, V[sel], base))
             check_reach(gctx, V[sel], tgts[-1], diagonal)
+            actions[str(name)] = describe_action(spec, V[sel])
     region = None
     if "region" in doc:
         rctx = ctx.at("region")
@@ -164,7 +178,7 @@ def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = 
                        region=region, solver=parse_mapping(doc.get("solver", {}), "solver",
                                             ctx.at("solver").error),
                        tracks=_tracks(ctx, tracks, dict(zip(names, ids)), merged_ids, V),
-                       warnings=ctx.warnings)
+                       warnings=ctx.warnings, actions=actions)
 
 
 def _tracks(ctx, tracks, groups, merged_ids, V):

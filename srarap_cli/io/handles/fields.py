@@ -5,9 +5,21 @@ from typing import Any
 import numpy as np
 
 from ...runtime.errors import InputError, unknown_key
+from ...runtime.numbers import spelled, whole
 
 #: Largest integer a handle file may hold (vertex ids and counts fit in int64 with room).
 MAX_INT = 2 ** 53
+
+
+def _numeric(value: Any) -> Any:
+    """``value`` with every number spelled as text made a float; raises TypeError for
+    anything else that is not a number (text, a truth value, null, a mapping)."""
+    if isinstance(value, (list, tuple)):
+        return [_numeric(v) for v in value]
+    value = spelled(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"not a number: {type(value).__name__}")
+    return value
 
 
 class Context:
@@ -68,12 +80,16 @@ class Context:
         return arr
 
     def numbers(self, value: Any, name: str) -> np.ndarray:
-        if isinstance(value, (str, bool)) or value is None:
-            raise self.error(f"{name} must be numeric")
+        """``value`` (a number, or nested lists of numbers) as a float array. A number is
+        any YAML or JSON number: YAML 1.1 reads ``9e1`` (an exponent without a dot) as text,
+        which is taken as the number it spells, in a scalar as in a vector."""
         try:
-            arr = np.asarray(value, dtype=float)
+            arr = np.asarray(_numeric(value), dtype=float)
         except (TypeError, ValueError):
             raise self.error(f"{name} must be numeric") from None
+        except OverflowError:
+            raise self.error(f"{name} must be finite (a number beyond the float range)") \
+                from None
         if not np.isfinite(arr).all():
             raise self.error(f"{name} must be finite")
         return arr
@@ -89,6 +105,10 @@ class Context:
         return x
 
     def integer(self, value: Any, name: str, minimum: int | None = None) -> int:
+        """``value`` as an int: an integer, or a number with no fraction (``5e0``, ``5.0``)."""
+        value = spelled(value)
+        if isinstance(value, (float, np.floating)):
+            value = whole(float(value))
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
             raise self.error(f"{name} must be an integer")
         if minimum is not None and value < minimum:

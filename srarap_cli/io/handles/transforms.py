@@ -142,11 +142,17 @@ def targets(ctx: Context, spec: dict, rest: np.ndarray, base: str) -> np.ndarray
     4x4 matrix given inline or as the path of a ``.def`` file.
     """
     out = _moved(ctx, spec, rest, base)
-    if not np.isfinite(out).all() or np.abs(out).max(initial=0) > MAX_COORDINATE:
-        where = f" ({spec['matrix']})" if isinstance(spec.get("matrix"), str) else ""
-        raise ctx.error(f"the action{where} sends vertices beyond {MAX_COORDINATE:g} or to "
-                        "infinite/NaN positions (entries too large)")
+    where = f" ({spec['matrix']})" if isinstance(spec.get("matrix"), str) else ""
+    check_bounds(ctx, out, f"the action{where}")
     return out
+
+
+def check_bounds(ctx: Context, moved: np.ndarray, what: str) -> None:
+    """Refuse targets ``moved`` (k, 3) that are not finite or lie beyond MAX_COORDINATE
+    (squares of such coordinates overflow in the solve)."""
+    if not np.isfinite(moved).all() or np.abs(moved).max(initial=0) > MAX_COORDINATE:
+        raise ctx.error(f"{what} sends vertices beyond {MAX_COORDINATE:g} or to "
+                        "infinite/NaN positions (entries too large)")
 
 
 def check_reach(ctx: Context, rest: np.ndarray, moved: np.ndarray, diagonal: float,
@@ -194,3 +200,50 @@ def _moved(ctx, spec, rest, base):
     if "translate" in spec:
         out = out + ctx.vector(spec["translate"], "translate", 3)
     return out
+
+
+def describe_action(spec: dict, rest: np.ndarray) -> str:
+    """A group's static action as its handle file states it, in words (for ``srarap info``):
+    the values as written, a default pivot as the centroid it is, no round-off.
+
+    Examples
+    --------
+    >>> rest = np.array([[0., 0, 0], [2, 0, 0]])
+    >>> describe_action({"rotate": {"axis": [0, 1, 0], "angle_deg": 90}}, rest)
+    "rotate 90 degrees (angle_deg) about axis (0, 1, 0) through the group's centroid (1, 0, 0)"
+    >>> describe_action({"translate": [0, 0, 2]}, rest)
+    'translate (0, 0, 2)'
+    """
+    if spec.get("fixed"):
+        return "fixed"
+    if "matrix" in spec:
+        M = spec["matrix"]
+        return f"matrix from {M}" if isinstance(M, str) else "matrix " + "; ".join(
+            _vec(row) for row in np.asarray(M, float).reshape(4, 4)[:3])
+    words = []
+    if "rotate" in spec:
+        rot = spec["rotate"]
+        key = next(k for k in (*ANGLE_KEYS, *QUATERNION_KEYS) if k in rot)
+        if key in QUATERNION_KEYS:
+            turn = f"rotate by {key} {_vec(rot[key])}"
+        else:
+            unit = {"angle_deg": "degrees", "angle_rad": "radians", "angle": "degrees"}[key]
+            turn = f"rotate {_num(rot[key])} {unit} ({key}) about axis {_vec(rot['axis'])}"
+        pivot = (f"through {_vec(spec['pivot'])}" if "pivot" in spec else
+                 f"through the group's centroid {_vec(rest.mean(axis=0), np.abs(rest).max())}")
+        words.append(f"{turn} {pivot}")
+    if "translate" in spec:
+        words.append(f"translate {_vec(spec['translate'])}")
+    return ", then ".join(words)
+
+
+def _num(x, scale=1.0):
+    """``x`` in 6 digits; rounding noise (below 1e-12 of ``scale``) and -0 written 0."""
+    x = float(x)
+    return f"{(0.0 if abs(x) < 1e-12 * scale else x) + 0.0:.6g}"
+
+
+def _vec(v, scale=None):
+    v = np.asarray(v, float).ravel()
+    scale = float(np.abs(v).max(initial=0)) if scale is None else float(scale)
+    return "(" + ", ".join(_num(x, scale) for x in v) + ")"

@@ -113,7 +113,7 @@ class Monitor:
         if self.reason is not None:
             row["stop"] = self.reason.value
         if self.callback is not None:
-            self.callback(row)
+            self.callback(dict(row))  # a copy: the caller's changes never reach the log
         return self.reason is not None
 
     def _reason(self, start, move, seconds):
