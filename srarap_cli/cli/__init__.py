@@ -73,7 +73,7 @@ class LazyGroup(click.Group):
     def _main_routed(self, args: Sequence[str] | None, prog_name: str | None,
                      complete_var: str | None, **extra: Any) -> NoReturn:
         try:
-            code = super().main(args, prog_name, complete_var, False, **extra)
+            code = self._parse_and_invoke(args, prog_name, **extra)
         except signals.Terminated:  # before a command's own handling took over
             signals.block()
             streams.release()
@@ -92,6 +92,18 @@ class LazyGroup(click.Group):
             click.echo("srarap: error: interrupted; no output written", err=True)
             sys.exit(130)
         sys.exit(code if isinstance(code, int) else 0)
+
+    def _parse_and_invoke(self, args: Sequence[str] | None, prog_name: str | None,
+                          **extra: Any) -> Any:
+        """What Click's main does before its own error handling (which prints a blank line
+        on an interrupt, a second line where srarap says one): parse, invoke, return the
+        exit code."""
+        args = sys.argv[1:] if args is None else list(args)
+        try:
+            with self.make_context(prog_name or "srarap", args, **extra) as ctx:
+                return self.invoke(ctx)
+        except click.exceptions.Exit as exc:
+            return exc.exit_code
 
     def format_commands(self, ctx: Context, formatter: HelpFormatter) -> None:
         with formatter.section("Commands"):

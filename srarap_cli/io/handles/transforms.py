@@ -225,16 +225,21 @@ def describe_action(spec: dict, rest: np.ndarray) -> str:
         rot = spec["rotate"]
         key = next(k for k in (*ANGLE_KEYS, *QUATERNION_KEYS) if k in rot)
         if key in QUATERNION_KEYS:
-            turn = f"rotate by {key} {_vec(rot[key])}"
+            q = _scaled(np.asarray(rot[key], float)[QUATERNION_KEYS[key]])
+            q = q / np.linalg.norm(q) * (1 if q[0] >= 0 else -1)
+            angle = float(np.degrees(2 * np.arctan2(np.linalg.norm(q[1:]), q[0])))
+            turn = (f"rotate {_num(angle)} degrees about {_vec(q[1:] / np.linalg.norm(q[1:]))} "
+                    f"({key} {_vec(rot[key])})" if angle > 1e-9 else "")
         else:
             unit = {"angle_deg": "degrees", "angle_rad": "radians", "angle": "degrees"}[key]
             turn = f"rotate {_num(rot[key])} {unit} ({key}) about axis {_vec(rot['axis'])}"
         pivot = (f"through {_vec(spec['pivot'])}" if "pivot" in spec else
                  f"through the group's centroid {_vec(rest.mean(axis=0), np.abs(rest).max())}")
-        words.append(f"{turn} {pivot}")
+        if turn:
+            words.append(f"{turn} {pivot}")
     if "translate" in spec:
         words.append(f"translate {_vec(spec['translate'])}")
-    return ", then ".join(words)
+    return ", then ".join(words) or "fixed"
 
 
 def _num(x, scale=1.0):

@@ -1,0 +1,253 @@
+"""The classes an outside audit found (issue 52), each checked against its contract: one line
+and the documented exit code, nothing half-written, or it simply works."""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import yaml
+from helpers import ROOT, run_cli
+
+import srarap_cli
+from srarap_cli import Deformer, read_mesh
+from srarap_cli.io.handles import parse_handles
+
+BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
+TWIST = os.path.join(ROOT, "configs", "bar-twist.yaml")
+V = read_mesh(BAR).vertices
+BASE = {"box": {"min": [-2, -2, -0.01], "max": [2, 2, 0.01]}, "fixed": True}
+TOP = {"box": {"min": [-2, -2, 9.99], "max": [2, 2, 10.01]}}
+
+
+def one_line(r, code):
+    assert r.returncode == code, r.stderr
+    lines = [line for line in r.stderr.splitlines() if line.startswith("srarap: error:")]
+    assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
+    return lines[0]
+
+
+# --- documents that refer to themselves ---------------------------------------------------
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("text", ["a: &a [*a]\n", "a: &a {b: *a}\n", "a: &a [1, [2, {c: *a}]]\n",
+                                  "- &a [*a, *a]\n"])
+def test_a_document_that_refers_to_itself_is_refused_at_once(tmp_path, text):
+    path = tmp_path / "r.yaml"
+    path.write_text(text + ("groups: {f: {indices: [0], fixed: true}}\n"
+                            if not text.startswith("-") else ""))
+    for args in (["info", BAR, path], ["deform", BAR, path, "-o", tmp_path / "o.obj"]):
+        line = one_line(run_cli(args), 4)
+        assert "refers to itself" in line and str(path) in line
+    manifest = tmp_path / "m.yaml"
+    manifest.write_text("x: &x [*x]\njobs: []\n")
+    assert "refers to itself" in one_line(run_cli(["batch", manifest, "-o", tmp_path]), 4)
+
+
+def test_shared_aliases_that_do_not_loop_are_read():
+    from srarap_cli.io.documents import _check_graph
+
+    node = yaml.compose("a: &x [1, 2]\nb: [*x, *x, {c: *x}]\n", Loader=yaml.SafeLoader)
+    _check_graph(node, "ok.yaml")  # no error
+
+
+# --- numbers as YAML and JSON spell them ----------------------------------------------------
+
+@pytest.mark.parametrize("spelled, value", [("9e1", 90.0), ("90", 90.0), ("9.0e1", 90.0),
+                                            ("+9E+1", 90.0), ("1_0", 10.0)])
+def test_a_scalar_reads_as_the_number_it_spells_like_a_vector_does(spelled, value):
+    doc = yaml.safe_load(f"groups:\n  base: {json.dumps(BASE)}\n  top:\n"
+                         f"    box: {json.dumps(TOP['box'])}\n"
+                         f"    rotate: {{axis: [0, 0, {spelled}], angle_deg: {spelled}}}\n")
+    c = parse_handles(doc, V)
+    ref = parse_handles({"groups": {"base": BASE, "top": {
+        **TOP, "rotate": {"axis": [0, 0, 1], "angle_deg": value}}}}, V)
+    assert np.allclose(c.targets, ref.targets, atol=1e-12)
+
+
+def test_times_frames_and_settings_take_exponents_without_a_dot():
+    doc = yaml.safe_load("solver: {tol: 1e-6, max_iter: 1e3}\ngroups:\n"
+                         f"  base: {json.dumps(BASE)}\n  top:\n    box: {json.dumps(TOP['box'])}\n"
+                         "    keyframes:\n      - {time: 0}\n      - {time: 5e-1, translate: [0, 1, 0]}\n"
+                         "      - {frame: 2e1, translate: [0, 2, 0]}\n")
+    c = parse_handles(doc, V, fps=24)
+    assert c.solver == {"tol": 1e-6, "max_iter": 1000}
+    assert c.tracks[0][2].frames.tolist() == [0.0, 12.0, 20.0]
+
+
+@pytest.mark.parametrize("value, words", [("1" + "0" * 400, "beyond the float range"),
+                                          ("1e400", "must be finite"), ("abc", "numeric")])
+def test_numbers_out_of_range_or_not_numbers_are_exit_4(tmp_path, value, words):
+    path = tmp_path / "h.yaml"
+    path.write_text(f"groups:\n  base: {json.dumps(BASE)}\n  top:\n"
+                    f"    box: {json.dumps(TOP['box'])}\n    translate: [{value}, 0, 0]\n")
+    line = one_line(run_cli(["deform", BAR, path, "-o", tmp_path / "o.obj"]), 4)
+    assert words in line and "translate" in line and not (tmp_path / "o.obj").exists()
+
+
+@pytest.mark.parametrize("args", [["bench", BAR, TWIST, "--time-budget", "nan"],
+                                  ["deform", BAR, TWIST, "-o", "o.obj", "--alpha", "nan"],
+                                  ["deform", BAR, TWIST, "-o", "o.obj", "--frame", "inf"],
+                                  ["compare", BAR, BAR, "--tol", "nan"],
+                                  ["render", BAR, "-o", "o.gif", "--fps", "nan"],
+                                  ["animate", BAR, TWIST, "-o", "f{}.obj", "--fps", "inf"]])
+def test_every_float_option_refuses_nan_and_infinity_as_usage(tmp_path, args):
+    assert "not a finite number" in one_line(run_cli(args, cwd=tmp_path), 2)
+
+
+# --- keyframes checked like static actions ---------------------------------------------------
+
+@pytest.mark.parametrize("group", [
+    {"pivot": [1e308, 0, 0], "keyframes": [{"frame": 0}, {"frame": 4, "rotate": {
+        "axis": [0, 0, 1], "angle_deg": 90}}]},
+    {"keyframes": [{"frame": 0}, {"frame": 3, "translate": [1e300, 0, 0]}]},
+    {"pivot": [1e200, 0, 0], "keyframes": [{"frame": 0}, {"frame": 2}]},
+])
+def test_a_keyframe_that_sends_vertices_away_is_refused_before_frame_0(tmp_path, group):
+    path = tmp_path / "k.yaml"
+    path.write_text(yaml.safe_dump({"groups": {"base": BASE, "top": {**TOP, **group}}}))
+    line = one_line(run_cli(["animate", BAR, path, "-o", str(tmp_path / "f_{:02d}.obj")]), 4)
+    assert "group 'top'" in line and not list(tmp_path.glob("f_*"))
+
+
+# --- outputs: streams that are full, names that are not UTF-8 --------------------------------
+
+def test_a_full_standard_error_loses_lines_not_the_run(tmp_path):
+    with open("/dev/full", "w") as full:
+        p = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", BAR, TWIST, "-o",
+                            str(tmp_path / "o.obj")], stderr=full, timeout=300)
+    assert p.returncode == 0 and (tmp_path / "o.obj").stat().st_size > 0
+
+
+@pytest.mark.parametrize("args", [["info", BAR], ["info", BAR, "--json"],
+                                  ["bench", BAR, TWIST, "--methods", "sr-linear",
+                                   "--time-budget", "2"]])
+def test_a_full_standard_output_is_exit_6_naming_it(args):
+    with open("/dev/full", "w") as full:
+        p = subprocess.run([sys.executable, "-m", "srarap_cli", *args], stdout=full,
+                           stderr=subprocess.PIPE, text=True, timeout=300)
+    assert "<stdout>" in one_line(p, 6)
+
+
+def test_names_the_shell_allows_are_written_escaped_where_the_format_needs_it(tmp_path):
+    odd = os.fsdecode(b"a\xff.obj")  # not UTF-8: Python holds it as a lone surrogate
+    (tmp_path / odd).write_bytes(open(BAR, "rb").read())
+    r = run_cli(["compare", odd, BAR, "--report", "r.html", "--junit", "j.xml",
+                 "--json", "c.json"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    from test_report import check_junit
+
+    assert check_junit((tmp_path / "j.xml").read_text())[0][-1].get("name").startswith(
+        "a\\udcff.obj")
+    assert "a\\udcff.obj" in (tmp_path / "r.html").read_text()
+    manifest = tmp_path / "m.json"
+    manifest.write_text(json.dumps({"jobs": [{"name": "x\ud800y", "mesh": BAR,
+                                              "handles": TWIST, "output": "o.obj"}]}))
+    r = run_cli(["batch", manifest, "-o", tmp_path / "out", "--junit", tmp_path / "out/j.xml",
+                 "--report", tmp_path / "out/r.html"])
+    assert r.returncode == 0, r.stderr
+    assert "x\\ud800y" in (tmp_path / "out" / "summary.csv").read_text()
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())[0]["job"] == "x\ud800y"
+
+
+# --- manifests ------------------------------------------------------------------------------
+
+def _manifest(tmp_path, outputs):
+    path = tmp_path / "m.yaml"
+    path.write_text(yaml.safe_dump({"jobs": [
+        {"name": f"j{k}", "mesh": BAR, "handles": TWIST, "output": out}
+        for k, out in enumerate(outputs)]}))
+    return path
+
+
+@pytest.mark.parametrize("outputs", [["x.obj", "x.obj/y.obj"], ["a/b.obj", "a/b.obj/c/d.obj"],
+                                     ["x.obj/y.obj", "x.obj"]])
+def test_an_output_inside_another_jobs_output_is_refused_when_read(tmp_path, outputs):
+    line = one_line(run_cli(["batch", _manifest(tmp_path, outputs), "-o", tmp_path / "out"]), 4)
+    assert "folder holding the other" in line and not (tmp_path / "out").exists()
+
+
+def test_an_output_a_symlink_carries_outside_the_folder_is_refused(tmp_path):
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    out.mkdir()
+    elsewhere.mkdir()
+    (out / "sub").symlink_to(elsewhere)
+    line = one_line(run_cli(["batch", _manifest(tmp_path, ["sub/x.obj"]), "-o", out]), 4)
+    assert "leads out of the output folder" in line and not list(elsewhere.iterdir())
+
+
+def test_a_symlink_that_loops_is_never_replaced_by_a_file(tmp_path):
+    (tmp_path / "loop.obj").symlink_to("loop.obj")
+    line = one_line(run_cli(["deform", BAR, TWIST, "-o", "loop.obj"], cwd=tmp_path), 6)
+    assert "loop.obj" in line and os.path.islink(tmp_path / "loop.obj")
+
+
+def test_a_report_that_cannot_be_written_leaves_the_summary(tmp_path):
+    out = tmp_path / "out"
+    r = run_cli(["batch", _manifest(tmp_path, ["a.obj"]), "-o", out, "--junit", "/dev/full"])
+    assert "/dev/full" in one_line(r, 6)
+    rows = json.loads((out / "summary.json").read_text())
+    assert rows[0]["status"] == "ok" and (out / "a.obj").exists()
+
+
+# --- info says what the file says -------------------------------------------------------------
+
+def test_info_states_a_collinear_groups_rotation_as_written(tmp_path):
+    x, y = np.meshgrid(np.arange(5.0), np.arange(5.0))
+    grid = np.c_[x.ravel(), y.ravel(), np.zeros(25)]
+    F = [[a, a + 1, a + 6] for a in range(20) if a % 5 < 4] + \
+        [[a, a + 6, a + 5] for a in range(20) if a % 5 < 4]
+    srarap_cli.write_mesh(str(tmp_path / "g.obj"), (grid, np.array(F)))
+    (tmp_path / "h.yaml").write_text(yaml.safe_dump({"groups": {
+        "base": {"indices": [0, 1, 2, 3, 4], "fixed": True},
+        "row": {"indices": [20, 21, 22, 23, 24],
+                "rotate": {"axis": [0, 1, 0], "angle_deg": 90}}}}))
+    r = run_cli(["info", tmp_path / "g.obj", tmp_path / "h.yaml"])
+    row = next(line for line in r.stdout.splitlines() if line.strip().startswith("row:"))
+    assert "fixed" not in row and "rotate 90 degrees (angle_deg) about axis (0, 1, 0)" in row
+    assert "centroid (2, 4, 0)" in row and "e-1" not in row
+
+
+def test_a_motion_of_collinear_vertices_is_not_called_fixed():
+    from srarap_cli.tasks.info import describe_motion
+
+    rest = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]])
+    turned = rest @ np.array([[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]]).T
+    assert "fixed" not in describe_motion(rest, turned)
+    assert describe_motion(rest, rest + [0, 1, 0]) == "translate (0, 1, 0)"
+
+
+# --- the Python API names what is wrong -------------------------------------------------------
+
+M = read_mesh(BAR)
+F = M.triangles()[0]
+IDS = np.arange(10)
+
+
+@pytest.mark.parametrize("call, kind, words", [
+    (lambda: Deformer(V * 1e200, F, IDS), ValueError, "V: vertex 0 has a coordinate beyond"),
+    (lambda: Deformer(np.zeros_like(V), F, IDS), ValueError, "V, F:"),
+    (lambda: Deformer(V, F, IDS, area=float("nan")), ValueError, "area must be"),
+    (lambda: Deformer(V, F, IDS, area=0), ValueError, "area must be"),
+    (lambda: Deformer(V, F, IDS, area=-5), ValueError, "area must be"),
+    (lambda: Deformer(V, F, IDS, area="big"), TypeError, "area must be a number"),
+    (lambda: Deformer(V, F, IDS, labels=np.zeros(3, int)), ValueError, "labels must be a 1-d"),
+    (lambda: Deformer(V, F, IDS, labels=np.full(10, 0.5)), TypeError, "labels must hold"),
+    (lambda: Deformer(V, F, IDS, labels=np.full(10, -1)), ValueError, "labels must be >= 0"),
+    (lambda: Deformer(V, F, IDS).solve(V[IDS], driver="nope"), ValueError, "driver 'nope'"),
+    (lambda: srarap_cli.read_mesh(12), TypeError, "path must be"),
+])
+def test_api_mistakes_name_the_argument(call, kind, words):
+    with pytest.raises(kind, match=words.replace("(", r"\(")):
+        call()
+
+
+def test_a_callback_that_changes_its_row_does_not_break_the_solve():
+    d = Deformer(V, F, IDS)
+    r = d.solve(V[IDS] + [0, 0, 0.1], callback=lambda row: row.clear())
+    assert r.converged and "total" in r.log[-1]
+
+
+def test_a_path_given_as_bytes_is_read():
+    assert len(srarap_cli.read_mesh(os.fsencode(BAR)).vertices) == len(V)
