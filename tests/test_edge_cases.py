@@ -35,11 +35,11 @@ def test_an_animation_that_stops_removes_the_later_frames_of_an_earlier_run(tmp_
 
 def test_a_hundred_million_frames_are_never_enumerated(tmp_path, monkeypatch):
     """The folder is listed, the frames' names never made one by one: counted."""
-    from srarap_cli.cli import animate
+    from srarap_cli.tasks import animate_job
 
     named = []
-    real = animate._frames_on_disk
-    monkeypatch.setattr(animate, "_frames_on_disk",
+    real = animate_job.frames_on_disk
+    monkeypatch.setattr(animate_job, "frames_on_disk",
                         lambda pattern: named.append(pattern) or real(pattern))
     r = _run("animate", BAR, ANIMATED, "-o", str(tmp_path / "f_{:09d}.obj"),
              "--frames", "100000000", "--max-frames", "1000000000", "--max-iter", "2")
