@@ -176,3 +176,21 @@ def test_a_yaml_syntax_error_gives_line_and_column(tmp_path):
     (tmp_path / "h.yaml").write_text("groups:\n  a: {indices: [0, fixed: true}\n")
     with pytest.raises(InputError, match=r"not valid YAML \(line 2, column \d+\)"):
         load_handles(str(tmp_path / "h.yaml"), V)
+
+
+def test_a_rotate_without_pivot_turns_about_the_groups_centroid():
+    """The documented default, on a group whose centroid is far from the origin and from
+    every axis (a tube turned about its own axis would pass with either pivot)."""
+    from scipy.spatial.transform import Rotation
+
+    from srarap_cli.io.handles import parse_handles
+
+    V = np.random.default_rng(3).normal(size=(40, 3)) + [5.0, -3.0, 7.0]
+    ids = np.arange(10, 20)
+    c = parse_handles({"groups": {"g": {"indices": ids.tolist(), "rotate": {
+        "axis": [1, 2, 2], "angle_deg": 70}}}}, V)
+    R = Rotation.from_rotvec(np.radians(70) * np.array([1, 2, 2]) / 3).as_matrix()
+    centroid = V[ids].mean(axis=0)
+    assert np.allclose(c.targets, (V[ids] - centroid) @ R.T + centroid, atol=1e-12)
+    # the centroid itself stays where it is; about the origin it would move by |c| x angle
+    assert np.allclose(c.targets.mean(axis=0), centroid, atol=1e-12)
