@@ -83,3 +83,29 @@ def test_from_arrays_keeps_polygons():
                          [[0, 1, 2, 3], [1, 4, 2]])
     assert m.face_sizes.tolist() == [4, 3]
     assert b"f 1 2 3 4" in format_mesh(m, ".obj")[0]
+
+
+def test_a_result_and_a_solver_print_as_one_short_line():
+    """A notebook cell ending in a result or a Deformer shows one line, not every array."""
+    from helpers import ROOT
+
+    import srarap_cli
+    from srarap_cli.solver.oneshot import make_deformer
+    from srarap_cli.solver.settings import resolve
+
+    bar = srarap_cli.read_mesh(f"{ROOT}/sample_meshes/bar.obj")
+    handles = srarap_cli.load_handles(f"{ROOT}/configs/bar-twist.yaml", bar.vertices)
+    d = srarap_cli.Deformer(bar.vertices, bar.triangles()[0], handles.ids)
+    r = d.solve(handles.targets)
+    assert repr(r) == (f"DeformResult(converged, {r.iterations} iterations, energy "
+                       f"{r.energy:.6g}, 658 vertices, 0 warnings)")
+    assert repr(d).startswith("Deformer(658 vertices, 1312 triangles, 34 constrained; ")
+    spot = srarap_cli.read_mesh(f"{ROOT}/sample_meshes/spot.obj")
+    nod = srarap_cli.load_handles(f"{ROOT}/configs/spot-nod.yaml", spot.vertices)
+    md = make_deformer(spot.vertices, spot.triangles()[0], nod.ids,
+                       settings=resolve({"multires": 2000}))
+    mr = md.solve(nod.targets)
+    for thing in (r, d, md, mr):
+        text = repr(thing)
+        assert "\n" not in text and len(text) < 200, text
+    assert repr(mr).startswith("MultiresResult(converged, ") and "coarse)" in repr(mr)

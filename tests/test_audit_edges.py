@@ -251,3 +251,24 @@ def test_a_callback_that_changes_its_row_does_not_break_the_solve():
 
 def test_a_path_given_as_bytes_is_read():
     assert len(srarap_cli.read_mesh(os.fsencode(BAR)).vertices) == len(V)
+
+
+# --- the newcomer's papercuts (issue 53) ------------------------------------------------------
+
+@pytest.mark.parametrize("text, words", [
+    ("jobz:\n  - {mesh: a.obj, handles: h.yaml, output: o.obj}\n",
+     "unknown key 'jobz' in the manifest; did you mean 'jobs'?"),
+    ("jobs:\n  - {mesh: a.obj, handles: h.yaml, outptu: o.obj}\n",
+     "job 0: unknown key 'outptu' in the job; did you mean 'output'?"),
+    ("jobs:\n  - {mesh: a.obj, handles: h.yaml, output: o.obj, expect: {golden: g.obj, "
+     "tool: 1}}\n", "unknown key 'tool' in expect; did you mean 'tol'?"),
+])
+def test_a_typo_in_a_manifest_key_gets_a_did_you_mean(tmp_path, text, words):
+    (tmp_path / "m.yaml").write_text(text)
+    assert words in one_line(run_cli(["batch", tmp_path / "m.yaml", "-o", tmp_path / "o"]), 4)
+
+
+def test_a_yaml_error_says_its_reason_not_only_its_context(tmp_path):
+    (tmp_path / "h.yaml").write_text("groups:\n\tbase: {indices: [0], fixed: true}\n")
+    line = one_line(run_cli(["info", BAR, tmp_path / "h.yaml"]), 4)
+    assert "found character '\\t' that cannot start any token" in line and "line 2" in line

@@ -145,3 +145,23 @@ def test_info_gives_euler_characteristic_genus_and_unreferenced_vertices():
     assert (closed["euler"], closed["genus"], closed["boundary_loops"]) == (0, 1, 0)
     lonely = mesh_info(Mesh.from_arrays(np.vstack([V, [[9.0, 9, 9]]]), F))
     assert lonely["genus"] == 1 and "1 unreferenced vertices" in lonely["problems"][-1]
+
+
+def test_the_up_guess_falls_back_to_y_when_the_extents_do_not_tell():
+    """A figure as wide as it is tall (the ogre: x 31.2, y 32.0, z 9.7) stands on y, as most
+    OBJ files do, and says it was assumed; two stray vertices do not turn a bar over."""
+    from helpers import ROOT
+
+    from srarap_cli.io.mesh import Mesh, read_mesh
+    from srarap_cli.tasks.info import up_axis, up_decided
+
+    rng = np.random.default_rng(0)
+    V = rng.uniform(0, 1, size=(400, 3)) * [31.2, 32.0, 9.7]
+    F = np.array([[i, i + 1, i + 2] for i in range(0, 396, 3)])
+    ogre = Mesh.from_arrays(V, F)
+    assert up_axis(ogre) == "y" and not up_decided(ogre)
+    bar = read_mesh(f"{ROOT}/sample_meshes/bar.obj")
+    assert up_axis(bar) == "z" and up_decided(bar)
+    strays = np.vstack([bar.vertices, [[40.0, 0, 5], [-40.0, 0, 5]]])
+    F = np.vstack([bar.triangles()[0], [[658, 0, 659]]])
+    assert up_axis(Mesh.from_arrays(strays, F)) == "z"

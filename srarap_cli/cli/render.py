@@ -13,12 +13,12 @@ from ..io.mesh.formats import MeshFormat
 from ..runtime.commit import commit_files
 from ..runtime.errors import InputError
 from ..tasks.frames import animated_gif, contact_sheet, frame_pictures, sheet_choice
-from ..tasks.info import up_axis
+from ..tasks.info import up_axis, up_decided
 from ..tasks.log_axis import decades_axis
 from ..tasks.preflight import check_output_path, read_any_mesh, refuse_overwrite
 from ..tasks.preview import preview_png
 from ..tasks.render import VIEWS
-from .common import FiniteFloat, guarded, input_format_option
+from .common import FiniteFloat, guarded, input_format_option, say
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -82,7 +82,7 @@ def render(mesh: str, out: str, handles: str | None, rest: str | None, color: st
     constraints = (load_handles(handles, (base or shown).vertices, any_rate=True) if handles
                    else None)
     if up == "auto":
-        up = up_axis(base or shown)
+        up = _auto_up(base or shown)
     commit_files([(out, preview_png(shown, base, constraints, color, layout, list(views),
                                     size, up))])
 
@@ -106,7 +106,7 @@ def _frames(pattern, out, handles, rest, color, layout, up, views, size, fps):
         raise InputError(f"{pattern}: the frames do not all have the same vertices")
     constraints = (load_handles(handles, meshes[0].vertices, any_rate=True) if handles
                    else None)
-    up = up_axis(meshes[0]) if up == "auto" else up
+    up = _auto_up(meshes[0]) if up == "auto" else up
     numbers = list(range(len(paths)))
     if out.lower().endswith(".png"):
         numbers = sheet_choice(len(paths))
@@ -219,3 +219,12 @@ def _number(value):
         return math.isfinite(float(value))
     except (TypeError, ValueError):
         return False
+
+
+def _auto_up(mesh):
+    """``--up auto``: the axis the extents tell, or y, said to be assumed."""
+    axis = up_axis(mesh)
+    if not up_decided(mesh):
+        say("srarap: note: drawn with +y up: the mesh's extents do not tell which axis is up "
+            "(most OBJ and PLY files are y-up); --up z if it stands on z")
+    return axis

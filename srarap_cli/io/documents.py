@@ -56,10 +56,21 @@ def load_document(path: str, kind: str) -> Any:
     except UnicodeDecodeError as exc:
         raise InputError(f"{path}: not UTF-8 text (byte {exc.start})") from None
     except (ValueError, yaml.YAMLError) as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        first = _reason(exc)
         mark = getattr(exc, "problem_mark", None)
         where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark is not None else ""
         raise InputError(f"{path}: not valid {kind.upper()}{where}: {first[:200]}") from None
+
+
+def _reason(exc):
+    """What is wrong, in one line: YAML's problem ("found character '\\t' that cannot start
+    any token") before its context ("while scanning for the next token"), which its first
+    line holds alone."""
+    problem, context = getattr(exc, "problem", None), getattr(exc, "context", None)
+    if problem:
+        return problem + (f" ({context})" if context else "")
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
 
 
 def _children(node):

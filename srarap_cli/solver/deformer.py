@@ -118,6 +118,15 @@ class DeformResult:
         """Extra lines a command prints about how the result was obtained (none here)."""
         return []
 
+    def __repr__(self) -> str:
+        """One line: how the solve ended, its size and energy (the arrays and the log are
+        attributes, not printed: a notebook cell ending in a result stays readable)."""
+        coarse = f" (+ {self.coarse_iterations} coarse)" if self.coarse_iterations else ""
+        state = "converged" if self.converged else str(self.stop_reason)
+        return (f"{type(self).__name__}({state}, {self.iterations} iterations{coarse}, "
+                f"energy {self.energy:.6g}, {len(self.positions)} vertices, "
+                f"{len(self.warnings)} warnings)")
+
 
 class Deformer:
     """SR-ARAP deformation of one triangle mesh with one set of constrained vertices.
@@ -219,6 +228,12 @@ class Deformer:
         self._response: LinearResponse | None = None
         if prepare:
             self.prepare()
+
+    def __repr__(self) -> str:
+        s = self.settings
+        return (f"Deformer({len(self.V)} vertices, {len(self.F)} triangles, "
+                f"{len(self.constrained)} constrained; {s.method}, alpha {s.alpha:g}, "
+                f"weights {s.weights})")
 
     def prepare(self) -> "Deformer":
         """Factor the Poisson matrix and build the local step, if not done yet."""

@@ -7,7 +7,6 @@ from ..io.handles import Constraints
 from ..io.mesh import Mesh
 from ..solver.group_rotations import group_rotors
 from ..solver.mesh_checks import edge_adjacency, edge_counts, mesh_warnings
-from ..solver.operators import triangle_normals
 from ..solver.quaternion import to_matrix
 from .pipeline import problem
 
@@ -174,22 +173,28 @@ def _boundary_loops(F):
 
 
 def _up_guess(V, F):
-    """y or z, whichever the mesh more likely stands on. An object at least twice as long
-    along one of them as across (a bar, a column, a standing figure) stands on its length;
-    otherwise the axis whose lowest slab carries more downward-facing area (a base, feet, a
-    bottom); y on a tie, as most OBJ and PLY files are y-up. A guess, and said to be one: a
-    lying cylinder fools it."""
+    """y or z, whichever the mesh stands on, when its extents tell: an object at least twice
+    as long along one of them as across (a bar, a column, a standing figure) stands on its
+    length. Extents are taken between the 1st and 99th percentile of the used vertices, so a
+    few stray vertices do not decide. Otherwise +y, as most OBJ and PLY files are y-up
+    (:func:`up_decided` says which case it was)."""
+    axis, _ = _up(V, F)
+    return axis
+
+
+def up_decided(mesh: Mesh) -> bool:
+    """Whether :func:`up_axis` was told by the mesh's extents (False: +y was assumed)."""
+    return _up(mesh.vertices, mesh.triangles()[0])[1]
+
+
+def _up(V, F):
     if not len(V) or not len(F):
-        return "+y"
-    lo, hi = V.min(axis=0), V.max(axis=0)
+        return "+y", False
+    used = np.zeros(len(V), bool)
+    used[F.ravel()] = True
+    lo, hi = np.percentile(V[used], [1, 99], axis=0)
     extent = hi - lo
     for k in (1, 2):
         if extent[k] >= 2 * max(extent[j] for j in range(3) if j != k):
-            return "+" + AXES[k]
-    normals = triangle_normals(V, F) / 2
-    centers = V[F].mean(axis=1)
-    scores = {}
-    for k in (1, 2):
-        low = centers[:, k] <= lo[k] + 0.05 * (hi[k] - lo[k])
-        scores[k] = -normals[low, k].sum()
-    return "+" + AXES[max((1, 2), key=lambda k: (scores[k], k == 1))]
+            return "+" + AXES[k], True
+    return "+y", False

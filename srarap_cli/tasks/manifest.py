@@ -6,17 +6,21 @@ import os
 from ..io.documents import load_document
 from ..io.handles import referenced_files
 from ..io.mesh.formats import extensions
-from ..runtime.errors import InputError, excerpt
+from ..runtime.errors import InputError, excerpt, unknown_key
 from ..runtime.paths import refuse_overwriting_inputs
 from ..solver.settings import parse_mapping
 from .batch_rows import Job
 
+TOP_KEYS = ("jobs", "defaults")
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
+EXPECT_KEYS = ("golden", "tol", "relative")
 
 
 def load_manifest(path: str) -> list[Job]:
     """Jobs of a manifest, with absolute paths and merged settings (list of dict)."""
     doc = load_document(path, "json" if path.lower().endswith(".json") else "yaml")
+    if isinstance(doc, dict):
+        _known(f"{path}", doc, TOP_KEYS, "the manifest")
     if not isinstance(doc, dict) or not isinstance(doc.get("jobs"), list) or not doc["jobs"]:
         raise InputError(f"{path}: a manifest needs a non-empty 'jobs' list")
     base = os.path.dirname(os.path.abspath(path))
@@ -26,11 +30,10 @@ def load_manifest(path: str) -> list[Job]:
     outputs: set[str] = set()
     for k, job in enumerate(doc["jobs"]):
         where = f"{path}: job {k}"
+        if isinstance(job, dict):
+            _known(where, job, JOB_KEYS, "the job")
         if not isinstance(job, dict) or not {"mesh", "handles", "output"} <= set(job):
             raise InputError(f"{where}: needs mesh, handles and output")
-        unknown = sorted(set(job) - set(JOB_KEYS))
-        if unknown:
-            raise InputError(f"{where}: unknown key {unknown[0]!r}")
         output = _output_name(where, job["output"])
         if output in outputs:
             raise InputError(f"{where}: output {output!r} is also another job's output")
@@ -42,6 +45,8 @@ def load_manifest(path: str) -> list[Job]:
         names.add(name)
         expect = job.get("expect")
         if expect is not None:
+            if isinstance(expect, dict):
+                _known(where, expect, EXPECT_KEYS, "expect")
             if not isinstance(expect, dict) or "golden" not in expect:
                 raise InputError(f"{where}: expect needs a golden mesh")
             tol = expect.get("tol", 0.0)
@@ -57,6 +62,13 @@ def load_manifest(path: str) -> list[Job]:
                      "settings": {**defaults, **_settings(where, "settings",
                                                           job.get("settings", {}))}})
     return jobs
+
+
+def _known(where, mapping, allowed, what):
+    """Refuse a key ``what`` does not take, with the nearest one it does as a hint."""
+    unknown = sorted(set(map(str, mapping)) - set(allowed))
+    if unknown:
+        raise InputError(f"{where}: {unknown_key(unknown[0], allowed, what)}")
 
 
 def _output_name(where, value):

@@ -42,7 +42,7 @@ WARM_UNCORRECTED = 5
 NO_GAIN = 0.5
 
 
-@dataclass
+@dataclass(repr=False)  # DeformResult's one line, not every array and log row
 class MultiresResult(DeformResult):
     """A :class:`DeformResult` of a multiresolution solve. Its ``log`` holds the coarse
     iterations (``step`` prefixed ``coarse-``), then, in ``refine`` mode, the full-resolution
@@ -221,6 +221,13 @@ class MultiresDeformer:
             self._settle()
             raise
         self.memory = {"setup": memory.stop(peak)}
+
+
+    def __repr__(self) -> str:
+        s = self.settings
+        return (f"MultiresDeformer({len(self.V)} vertices through {self.coarse.vertices.size}, "
+                f"{len(self.F)} triangles, {len(self.constrained)} constrained; {s.method}, "
+                f"alpha {s.alpha:g}, {s.multires_mode})")
 
     def _build_levels(self, size, groups, cache, built, start):
         """Everything of the setup but the full-resolution factorizations (see __init__)."""
