@@ -72,11 +72,16 @@ def commands(mesh, tmp):
             "compare, second": ["compare", BAR, mesh, "-q"],
             "render": ["render", mesh, "-o", tmp / "r.png"],
             "animate": ["animate", mesh, ANIMATED, "-o", str(tmp / "f_{:02d}.obj"),
-                        "--frames", "2", "-q"]}
+                        "--frames", "2", "-q"],
+            "bench": ["bench", mesh, TWIST, "--methods", "sr-linear", "--time-budget", "1",
+                      "-o", tmp / "bench"]}
 
 
-@pytest.mark.parametrize("command", ["deform", "info", "info with handles", "compare",
-                                     "compare, second", "render", "animate"])
+COMMANDS = ["deform", "info", "info with handles", "compare", "compare, second", "render",
+            "animate", "bench"]
+
+
+@pytest.mark.parametrize("command", COMMANDS)
 def test_every_command_gives_0_2_or_4_and_one_line_for_any_mesh_path(paths, command,
                                                                       tmp_path):
     for name, (path, allowed) in paths.items():
@@ -99,6 +104,21 @@ def _shell(command, **kwargs):
 
 
 @pytest.mark.slow
+@pytest.mark.slow
+@pytest.mark.parametrize("command", COMMANDS)
+@pytest.mark.parametrize("how", ["cat {bar} | {cmd}", "{cmd} < {bar}", "{cmd_fifo}"])
+def test_every_command_reads_a_mesh_from_a_pipe_fifo_or_dev_stdin(command, how, tmp_path):
+    srarap = f"{sys.executable} -m srarap_cli"
+    args = [str(a) for a in commands("MESH", tmp_path)[command]]
+    cmd = srarap + " " + " ".join(f"'{a}'" for a in args)
+    fifo = tmp_path / "pipe"
+    line = how.format(cmd=cmd.replace("'MESH'", "/dev/stdin"), bar=BAR,
+                      cmd_fifo=f"mkfifo {fifo}; (cat {BAR} > {fifo} &); "
+                               + cmd.replace("'MESH'", str(fifo)))
+    p = _shell(line)
+    assert p.returncode == 0, (line, p.stderr.decode()[-600:])
+
+
 @pytest.mark.parametrize("how", [
     "cat {bar} | {srarap} deform /dev/stdin {twist} -o {out} -q",
     "{srarap} deform <(cat {bar}) {twist} -o {out} -q",

@@ -105,7 +105,7 @@ def run_animation(job: AnimateJob,
                      + [job.log], mesh=job.mesh, handles=job.handles,
                      others=[("resume state", state_path)])
     opts = resolve(constraints.solver, dict(job.settings))
-    run_id = fingerprint((job.mesh, job.handles, *referenced_files(job.handles)), opts,
+    run_id = fingerprint(source, (job.handles, *referenced_files(job.handles)), opts,
                          n_frames, job.fps, job.iters_per_frame, job.pattern)
     state = _resume_state(state_path, run_id) if job.resume else None
     animator = Animator(source, constraints, opts, cache=job.cache, name=job.mesh)

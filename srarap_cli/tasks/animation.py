@@ -153,10 +153,13 @@ def _carried(P, R, before):
 _CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
 
 
-def fingerprint(paths: Sequence[str], opts: Settings, *extra: Any) -> str:
-    """Content hash of the files ``paths``, the resolved settings and anything else that
-    decides the frames (``extra``, JSON-serializable): a resume state belongs to one run."""
+def fingerprint(mesh: Mesh, paths: Sequence[str], opts: Settings, *extra: Any) -> str:
+    """Content hash of the mesh as read (a pipe cannot be read twice), the files ``paths``,
+    the resolved settings and anything else that decides the frames (``extra``,
+    JSON-serializable): a resume state belongs to one run."""
     h = hashlib.sha256()
+    for array in (mesh.vertices, mesh.face_sizes, mesh.face_vertices):
+        h.update(np.ascontiguousarray(array).tobytes())
     for path in paths:
         h.update(hashlib.sha256(read_input_bytes(path)).digest())
     h.update(json.dumps([opts.as_dict(), *extra], sort_keys=True).encode())
