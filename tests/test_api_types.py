@@ -1,6 +1,8 @@
 """The API takes what users have: (V, F) pairs, trimesh and meshio meshes, srarap's Mesh;
 handles as a file, a dict or (ids, targets); results convert back; mistakes name the argument.
 Every form gives the same bytes as the command line."""
+import os
+
 import meshio
 import numpy as np
 import pytest
@@ -109,3 +111,32 @@ def test_a_result_and_a_solver_print_as_one_short_line():
         text = repr(thing)
         assert "\n" not in text and len(text) < 200, text
     assert repr(mr).startswith("MultiresResult(converged, ") and "coarse)" in repr(mr)
+
+
+@pytest.mark.slow
+def test_the_public_names_type_check_for_a_user(tmp_path):
+    """The lazily loaded names are typed for a checker (__init__.pyi): mypy sees the class,
+    the functions' signatures, and refuses a wrong call."""
+    import subprocess
+    import sys
+
+    from helpers import ROOT
+
+    import srarap_cli
+
+    stub = open(f"{ROOT}/srarap_cli/__init__.pyi").read()
+    assert all(f"import {name} as {name}" in stub for name in srarap_cli._WHERE)
+    (tmp_path / "user.py").write_text(
+        "import srarap_cli\n"
+        "reveal_type(srarap_cli.Deformer)\n"
+        "reveal_type(srarap_cli.read_mesh)\n"
+        "srarap_cli.read_mesh(3.5, 1, 2, 3)\n")
+    # the package's source on mypy's path: an editable install's import hook is invisible
+    # to a checker (an installed wheel is found in site-packages)
+    p = subprocess.run([sys.executable, "-m", "mypy", "--no-incremental",
+                        str(tmp_path / "user.py")], capture_output=True, text=True,
+                       timeout=600, cwd=tmp_path, env={**os.environ, "MYPYPATH": ROOT})
+    out = p.stdout
+    assert 'Revealed type is "def (V: ' in out and "srarap_cli.solver.deformer.Deformer" in out
+    assert "def (path:" in out and "Any" not in out.splitlines()[0]
+    assert "Too many arguments" in out

@@ -120,7 +120,7 @@ def _frames(pattern, out, handles, rest, color, layout, up, views, size, fps):
 def _frame_files(pattern):
     """The files of a frame pattern from frame 0 up to the first missing one."""
     try:
-        paths = []
+        paths: list[str] = []
         while os.path.isfile(pattern.format(len(paths))):
             paths.append(pattern.format(len(paths)))
             if len(paths) > MAX_FRAMES:

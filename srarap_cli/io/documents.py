@@ -85,7 +85,8 @@ def _check_graph(root, path):
     """Refuse a composed YAML graph that expands past MAX_NODES or MAX_DEPTH."""
     if root is None:
         return
-    size, depth = {}, {}
+    size: dict[int, int] = {}
+    depth: dict[int, int] = {}
     open_ = set()  # nodes whose children are being measured: meeting one again is a cycle
     stack = [(root, False)]
     while stack:

@@ -132,7 +132,7 @@ def background(func: Callable[[], T]) -> Callable[[], T]:
     >>> wait()
     42
     """
-    out = {}
+    out: dict[str, Any] = {}
 
     def run():
         try:

@@ -117,6 +117,7 @@ def _summarize(runs, ids, targets):
              "max_constraint_error": float(np.abs(r.positions[ids] - targets).max())}
         for frac in THRESHOLDS:
             # an unclamped classic ARAP energy can be negative: ``within`` means above it
+            assert low is not None  # every method logged its start
             hit = next((row for row in r.log if row["total"] <= low + frac * abs(low)), None)
             key = f"{frac * 100:g}%"
             s[f"iterations_to_{key}"] = hit["iteration"] if hit else None

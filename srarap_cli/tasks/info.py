@@ -131,7 +131,8 @@ def _overlaps(groups, n):
     names = list(groups)
     sizes = [len(ids) for ids in groups.values()]
     rows = np.repeat(np.arange(len(names)), sizes)
-    cols = np.concatenate([np.asarray(ids, np.int64) for ids in groups.values()] or [[]])
+    cols = np.concatenate([np.asarray(ids, np.int64) for ids in groups.values()]
+                          or [np.zeros(0, np.int64)])
     member = sp.csr_matrix((np.ones(rows.size), (rows, cols.astype(np.int64))),
                            shape=(len(names), n))
     member.data[:] = 1.0  # a vertex a group lists twice counts once

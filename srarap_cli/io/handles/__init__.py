@@ -187,7 +187,7 @@ def _tracks(ctx, tracks, groups, merged_ids, V):
     for name, track in tracks.items():
         mine = groups[name]
         for other, theirs in groups.items():
-            shared = np.intersect1d(mine, theirs) if other != name else ()
+            shared = np.intersect1d(mine, theirs) if other != name else np.zeros(0, int)
             if len(shared):
                 raise ctx.error(f"vertex {shared[0]} is in keyframed group {name!r} and in "
                                 f"group {other!r}")

@@ -7,6 +7,7 @@ judge of what it cannot express (a vertex in two groups with different targets, 
 range, a .def's last row).
 """
 import json
+from typing import Any
 
 from ...solver.settings import SETTINGS
 from .keyframes import EASINGS
@@ -72,14 +73,15 @@ def _keyframe():
 
 
 def _setting(s):
-    kind = {"float": {"type": "number"}, "int": {"type": "integer"},
-            "flag": {"type": "boolean"},
-            "choice": {"enum": list(s.choices)},
-            "size": {"oneOf": [{"type": "integer", "minimum": 4},
-                               {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
-                               {"type": "string",
-                                "pattern": r"^\s*(off|auto|\d+(\.\d*)?\s*%|0*\.\d+)\s*$"}]}
-            }[s.kind]
+    kinds: dict[str, dict[str, Any]] = {
+        "float": {"type": "number"}, "int": {"type": "integer"},
+        "flag": {"type": "boolean"},
+        "choice": {"enum": list(s.choices)},
+        "size": {"oneOf": [{"type": "integer", "minimum": 4},
+                           {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
+                           {"type": "string",
+                            "pattern": r"^\s*(off|auto|\d+(\.\d*)?\s*%|0*\.\d+)\s*$"}]}}
+    kind = kinds[s.kind]
     if s.minimum is not None and s.kind in ("float", "int"):
         kind["exclusiveMinimum" if s.strict else "minimum"] = s.minimum
     if s.default is None:

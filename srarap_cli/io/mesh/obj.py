@@ -84,7 +84,7 @@ def _read_bulk(text):
     return mesh
 
 
-def _block(text, head):
+def _block(text: str, head: str) -> tuple[str, int]:
     """The numbers of every ``head`` line as one text, and how many lines: from one slice
     when those lines come together, as writers put them (a third of a findall's time)."""
     key = f"\n{head} "
@@ -119,7 +119,7 @@ def _statements(text, read):
     return found
 
 
-def _rows_of(numbers, lines, least):
+def _rows_of(numbers: str, lines: int, least: int) -> np.ndarray | None:
     """Rows of the first three numbers of ``lines`` lines of text (as the general reader
     takes them) when every line holds the same count of numbers, at least ``least``; None
     otherwise.
@@ -244,14 +244,14 @@ def _face_block(mesh, offsets, first, stop):
     sizes = mesh.face_sizes[first:stop]
     corners = slice(offsets[first], offsets[stop])
     columns, has = [mesh.face_vertices[corners]], []
-    for ids in (mesh.face_uv, mesh.face_normals):
-        ids = None if ids is None else ids[corners]
+    for table in (mesh.face_uv, mesh.face_normals):
+        ids = None if table is None else table[corners]
         has.append(ids is not None and bool((ids >= 0).any()))
-        if has[-1]:
+        if ids is not None and has[-1]:
             if (ids < 0).any():
                 return None
             columns.append(ids)
-    line = "f" + (" " + _CORNER_FORMS[tuple(has)]) * int(sizes[0]) + "\n"
+    line = "f" + (" " + _CORNER_FORMS[(has[0], has[1])]) * int(sizes[0]) + "\n"
     return line * sizes.size % tuple((np.column_stack(columns) + 1).ravel().tolist())
 
 
@@ -290,7 +290,8 @@ def _normal_lines(mesh):
 def _fixed_text(mesh):
     """The text before the coordinates (the header, statements before any face) and after
     them (faces, with the statements among them)."""
-    later, count = {}, mesh.face_sizes.size
+    later: dict[int, list[str]] = {}
+    count = mesh.face_sizes.size
     for k, s in mesh.statements:  # one said to follow more faces than there are goes last
         later.setdefault(min(k, count), []).append(s + "\n")
     head = "".join(["# written by srarap\n", *later.pop(0, ())])
@@ -299,7 +300,7 @@ def _fixed_text(mesh):
     offsets = mesh.face_offsets
     bounds = [0, *sorted(later), count]
     lines = _face_lines(mesh, offsets, 0, count) if 8 * len(bounds) > count else None
-    parts = []
+    parts: list[str] = []
     for first, stop in zip(bounds, bounds[1:]):
         parts.extend(later.get(first, ()))
         if stop > first:
@@ -316,7 +317,7 @@ def _face_text(mesh, offsets, first, stop):
     if 64 * changes.size > stop - first:
         return _face_lines(mesh, offsets, first, stop)
     bounds = [first, *changes.tolist(), stop]
-    out = []
+    out: list[str] = []
     for a, b in zip(bounds, bounds[1:]):
         block = _face_block(mesh, offsets, a, b)
         out.extend([block] if block is not None else _face_lines(mesh, offsets, a, b))

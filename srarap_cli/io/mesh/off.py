@@ -4,6 +4,8 @@ Written by hand because meshio's reader rejects common headers (for example a do
 in the count line) and libigl's triangulates polygons away.
 """
 
+from typing import Any
+
 import numpy as np
 
 from ...runtime.errors import InputError, excerpt
@@ -77,7 +79,7 @@ def _read_general(path):
     if not keyword.endswith("OFF"):
         raise InputError(f"{path}: not an OFF file (first word {excerpt(header[0], 20)!r})")
     prefix = keyword[:-3]
-    counts = header[1:] or next(lines, [])
+    counts: list[Any] = header[1:] or next(lines, [])
     try:
         nv, nf = int(counts[0]), int(counts[1])
     except (IndexError, ValueError):

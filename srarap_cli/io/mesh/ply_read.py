@@ -6,6 +6,8 @@ allocated gigabytes before failing, a header without ``end_header`` spun forever
 with no corners reached libigl and crashed the process.
 """
 
+from typing import Any
+
 import numpy as np
 
 from ...runtime.errors import InputError, excerpt
@@ -56,7 +58,8 @@ def _header(data, path):
         raise InputError(f"{path}: no 'end_header' in the first {MAX_HEADER} bytes")
     stop = data.find(b"\n", end)
     start = len(data) if stop < 0 else stop + 1
-    fmt, elements = None, []
+    fmt: str | None = None
+    elements: list[Any] = []
     for raw in data[:end].decode("ascii", errors="replace").splitlines()[1:]:
         words = raw.split()
         if not words or words[0] in ("comment", "obj_info"):
@@ -108,7 +111,7 @@ def _ascii_element(lines, at, name, count, props, path):
             raise InputError(f"{path}: element '{excerpt(name)}' has a non-numeric value") from None
         return {p: _cast(table[:, k], t, name, p, path) for k, (p, t) in enumerate(props)}, \
             at + count
-    out = {p: [] for p, _ in props}
+    out: dict[str, list] = {p: [] for p, _ in props}
     for k, row in enumerate(rows):
         pos = 0
         try:
@@ -204,8 +207,8 @@ def _uniform_rows(body, at, order, count, props):
 
 def _binary_rows(body, at, order, name, count, props, path):
     """Entries one at a time (lists of mixed lengths)."""
-    out = {p: [] for p, _ in props}
-    sizes = {p: [] for p, t in props if isinstance(t, tuple)}
+    out: dict[str, list] = {p: [] for p, _ in props}
+    sizes: dict[str, list] = {p: [] for p, t in props if isinstance(t, tuple)}
     pos = at
     for k in range(count):
         for p, t in props:
@@ -224,7 +227,7 @@ def _binary_rows(body, at, order, name, count, props, path):
             out[p].append(np.frombuffer(body, order + t[1], n, pos))
             sizes[p].append(n)
             pos += n * width
-    result = {}
+    result: dict[str, Any] = {}
     for p, t in props:
         if isinstance(t, tuple):
             flat = np.concatenate(out[p]) if out[p] else np.zeros(0, t[1])

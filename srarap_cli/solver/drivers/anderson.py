@@ -131,6 +131,7 @@ class AndersonMixer:
             self._dF = np.empty((self.depth, df.size), dtype=HISTORY_DTYPE)
             self._dG = np.empty((self.depth, dg.size), dtype=HISTORY_DTYPE)
             self._gram = np.empty((self.depth, self.depth))
+        assert self._dG is not None and self._gram is not None  # allocated with _dF
         i = self._next
         self._dF[i], self._dG[i] = df / scale, dg / scale
         self._count = min(self._count + 1, self.depth)

@@ -124,6 +124,7 @@ class RotorSystem:
 
     def _solve(self, A, b, x0, forcing):
         solve = self._precondition
+        assert solve is not None  # there are free rotors to solve for
         # with its dtype given, LinearOperator does not try a preconditioner solve to guess it
         precond = spla.LinearOperator(
             A.shape, matvec=lambda v: solve(v.reshape(-1, 4)).ravel(),

@@ -323,6 +323,7 @@ class MultiresDeformer:
         args = (self.V[cv], self.coarse.faces, np.flatnonzero(in_coarse))
         labels = self.labels[self._coarse_slots]
         size = coarse_size("auto", cv.size) if self.mode == "refine" else None
+        self.coarse_deformer: Deformer | MultiresDeformer
         if size is None:
             self.coarse_deformer = Deformer(*args, settings=self.settings, area=self.area,
                                             labels=labels)

@@ -1,0 +1,18 @@
+# The public names' types for editors and type checkers: the package loads them lazily
+# (__init__.py's __getattr__), which a checker cannot follow. Keep in step with _WHERE there
+# (tests/test_api_types.py checks both name the same objects).
+from .io.handles import Constraints as Constraints
+from .io.handles import load_handles as load_handles
+from .io.mesh import Mesh as Mesh
+from .io.mesh import read_mesh as read_mesh
+from .io.mesh import write_mesh as write_mesh
+from .solver.deformer import Deformer as Deformer
+from .solver.deformer import DeformResult as DeformResult
+from .solver.interface import Solver as Solver
+from .solver.settings import Settings as Settings
+from .solver.stop import StopReason as StopReason
+from .tasks.api import deform as deform
+from .tasks.pipeline import deform_mesh as deform_mesh
+
+__version__: str
+__all__: list[str]
