@@ -141,3 +141,23 @@ def test_mypy_runs_over_the_whole_package():
     assert mypy["files"] == ["srarap_cli"]
     with open(os.path.join(ROOT, ".ci", "run")) as fh:
         assert re.search(r"^mypy$", fh.read(), re.M)
+
+
+def test_package_files_only_re_export():
+    """A package's ``__init__`` holds its docstring and re-exports (imports, ``__all__``; a
+    lazy package its table of names and module ``__getattr__`` / ``__dir__``): the code lives
+    in modules named for what they do."""
+    allowed_names = {"__all__", "_WHERE"}
+    for module, path in MODULES.items():
+        if not path.endswith("__init__.py"):
+            continue
+        tree = ast.parse(open(path, encoding="utf-8").read())
+        for node in tree.body:
+            ok = (isinstance(node, (ast.Import, ast.ImportFrom))
+                  or (isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant))
+                  or (isinstance(node, (ast.Assign, ast.AnnAssign)) and all(
+                      isinstance(t, ast.Name) and t.id in allowed_names
+                      for t in (node.targets if isinstance(node, ast.Assign) else [node.target])))
+                  or (isinstance(node, ast.FunctionDef) and node.name in ("__getattr__",
+                                                                          "__dir__")))
+            assert ok, f"{module}: line {node.lineno} is not a re-export"

@@ -6,18 +6,7 @@ of one local/global iteration) from the start ``state`` and hands every iterate 
 answers whether to stop (tolerance, iteration cap, time limit). :data:`DRIVERS` maps names to
 drivers; :func:`register` adds one.
 """
-from collections.abc import Callable
-
-from .anderson import anderson_iteration
 from .monitor import Monitor
-from .plain import plain_iteration
-
-DRIVERS: dict[str, Callable] = {"plain": plain_iteration, "anderson": anderson_iteration}
-
-
-def register(name: str, driver: Callable) -> None:
-    """Make ``driver`` available as ``Deformer.solve(..., driver=name)``."""
-    DRIVERS[name] = driver
-
+from .registry import DRIVERS, register
 
 __all__ = ["DRIVERS", "Monitor", "register"]
