@@ -194,3 +194,21 @@ def test_a_rotate_without_pivot_turns_about_the_groups_centroid():
     assert np.allclose(c.targets, (V[ids] - centroid) @ R.T + centroid, atol=1e-12)
     # the centroid itself stays where it is; about the origin it would move by |c| x angle
     assert np.allclose(c.targets.mean(axis=0), centroid, atol=1e-12)
+
+
+def test_a_box_and_a_sphere_select_the_vertices_on_their_boundary():
+    """Closed sets, as the docs say: a box's faces and a sphere's surface belong to them (a
+    handle box drawn at a mesh's extent must select its end vertices)."""
+    from srarap_cli.io.handles import parse_handles
+
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 1], [0.5, 0.5, 0.5], [1.0000001, 0, 0],
+                  [2, 0, 0], [0, 0, 2]])
+    box = parse_handles({"groups": {"g": {"box": {"min": [0, 0, 0], "max": [1, 1, 1]},
+                                          "fixed": True}}}, V)
+    assert box.ids.tolist() == [0, 1, 2, 3]
+    ball = parse_handles({"groups": {"g": {"sphere": {"center": [0, 0, 0], "radius": 2},
+                                           "fixed": True}}}, V)
+    assert ball.ids.tolist() == [0, 1, 2, 3, 4, 5, 6]
+    small = parse_handles({"groups": {"g": {"sphere": {"center": [0, 0, 0], "radius": 1},
+                                            "fixed": True}}}, V)
+    assert small.ids.tolist() == [0, 1, 3]
