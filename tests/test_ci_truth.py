@@ -425,3 +425,22 @@ def test_a_signal_as_a_local_dask_cluster_starts_leaves_nothing_running(tmp_path
         lines = err.decode().splitlines()
         # no library's own lines: the table, the summary or the one error line only
         assert all(line.startswith(("srarap", "j")) for line in lines), lines
+
+
+def test_a_job_regresses_on_its_farthest_vertex_not_its_mean(tmp_path):
+    """One vertex 0.1 away and the rest exact: the mean is far below tol, the job regressed."""
+    from srarap_cli.tasks.golden import check_golden
+    from srarap_cli.tasks.job_status import JobResult
+
+    bar = read_mesh(BAR)
+    moved = bar.vertices.copy()
+    moved[5] += [0.1, 0, 0]
+    write_mesh(tmp_path / "out.obj", bar.with_vertices(moved))
+    result = JobResult("j", JobStatus.OK, 0)
+    check_golden(result, {"golden": BAR, "tol": 0.01, "relative": False}, str(tmp_path / "out.obj"))
+    assert result.status is JobStatus.REGRESSED and result.exit_code == 7
+    assert abs(result.compare_max - 0.1) < 1e-12 and result.compare_mean < 0.01
+    assert "vertex 5" in result.message
+    within = JobResult("j", JobStatus.OK, 0)
+    check_golden(within, {"golden": BAR, "tol": 0.2, "relative": False}, str(tmp_path / "out.obj"))
+    assert within.status is JobStatus.OK

@@ -136,7 +136,7 @@ def test_malformed_handle_file_is_invalid_input_and_writes_nothing(small, tmp_pa
 
 def test_usage_and_output_errors(small, tmp_path):
     mesh, handles = small
-    assert run(mesh, handles, "-o", tmp_path / "o.vtk").exit_code == 2
+    assert run(mesh, handles, "-o", tmp_path / "o.xyz").exit_code == 2
     assert run(mesh, handles, "-o", tmp_path / "o.obj", "--alpha", "0").exit_code == 2
     r = run(mesh, handles, "-o", tmp_path / "new" / "folders" / "o.obj")  # made, as animate's
     assert r.exit_code == 0 and (tmp_path / "new" / "folders" / "o.obj").is_file()

@@ -133,11 +133,11 @@ def test_truncated_off_and_unknown_format_are_invalid_input(tmp_path):
     with pytest.raises(InputError, match="ends early"):
         read_mesh(str(path))
     # an extension no format claims: the content decides, and text of no format is refused
-    (tmp_path / "x.vtk").write_text("# vtk DataFile Version 2.0\nASCII\n")
-    with pytest.raises(InputError, match="x.vtk: not a mesh: it is text"):
-        read_mesh(str(tmp_path / "x.vtk"))
-    with pytest.raises(InputError, match="y.vtk: cannot read: No such file"):
-        read_mesh(str(tmp_path / "y.vtk"))
+    (tmp_path / "x.xyz").write_text("# points\n0 0 0\n1 0 0 x\n")
+    with pytest.raises(InputError, match="x.xyz: not a mesh: it is text"):
+        read_mesh(str(tmp_path / "x.xyz"))
+    with pytest.raises(InputError, match="y.xyz: cannot read: No such file"):
+        read_mesh(str(tmp_path / "y.xyz"))
 
 
 @pytest.mark.parametrize("binary", [True, False])

@@ -69,7 +69,7 @@ def test_the_options_table_is_the_settings_table():
 
 
 def test_the_formats_table_is_the_format_registry():
-    from srarap_cli.io.mesh.formats import markdown_table
+    from srarap_cli.io.mesh.meshio_formats import markdown_table
     assert markdown_table() in Path(ROOT, "README.md").read_text(encoding="utf-8")
 
 

@@ -12,8 +12,9 @@ import numpy as np
 from ..io.handles import Constraints, load_handles, referenced_files
 from ..io.mesh import MeshFormat, open_mesh
 from ..io.mesh.mesh import Mesh
+from ..io.mesh.meshio_formats import needs
 from ..io.mesh.stream import read_mesh_stream
-from ..runtime.errors import OutputError, UsageProblem
+from ..runtime.errors import InputError, OutputError, UsageProblem
 from ..runtime.paths import refuse_overwriting_inputs
 
 
@@ -23,6 +24,8 @@ def check_output_path(path: str, allowed: Sequence[str] | None, what: str) -> No
     every command makes the missing folders of its outputs when it writes them. A device or
     a descriptor (``/dev/stdout``, ``/dev/null``) is written through whatever its name."""
     ext = os.path.splitext(path)[1].lower()
+    if allowed is not None and ext not in allowed and (hint := needs(ext)):
+        raise InputError(f"{path}: {hint}")
     if allowed is not None and ext not in allowed and not _device(path):
         raise UsageProblem(f"{what} {path!r}: extension must be one of {', '.join(allowed)}")
     folder = os.path.dirname(os.path.abspath(path))

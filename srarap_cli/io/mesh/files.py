@@ -9,6 +9,7 @@ from ...runtime.errors import InputError, OutputError
 from ...runtime.limits import MAX_COORDINATE, check_read
 from .formats import HEAD_BYTES, MeshFormat, by_content, by_extension, extensions
 from .mesh import Mesh
+from .meshio_formats import needs
 from .sniff import not_a_mesh
 from .stream import read_mesh_stream
 
@@ -40,6 +41,8 @@ def open_mesh(path: str | os.PathLike, fmt: MeshFormat | None = None
     if os.path.isdir(path):
         raise InputError(f"{path}: is a folder, not a mesh file")
     fmt = fmt or by_extension(path)
+    if fmt is None and (hint := needs(os.path.splitext(path)[1])):
+        raise InputError(f"{path}: {hint}")
     if fmt is None:
         if not os.path.isfile(path):  # a pipe, a device, a process substitution: one pass
             return _read_stream(path)
@@ -114,6 +117,8 @@ def format_mesh(mesh: Mesh, suffix: str, ascii: bool = False) -> tuple[bytes, li
 
 def _writable(suffix):
     fmt = by_extension("x" + suffix)
+    if fmt is None and (hint := needs(suffix)):
+        raise InputError(f"{suffix}: {hint}")
     if fmt is None:
         raise OutputError(f"cannot write {suffix or 'files without extension'}; "
                           f"use one of {_listed()}")
@@ -143,6 +148,8 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh) -> list[str]:
 
         mesh = Mesh.from_arrays(*mesh_like(mesh))
     fmt = by_extension(str(path))
+    if fmt is None and (hint := needs(os.path.splitext(str(path))[1])):
+        raise InputError(f"{path}: {hint}")
     if fmt is None:
         suffix = os.path.splitext(str(path))[1].lower()
         raise OutputError(f"{path}: cannot write {suffix or 'files without extension'}; "

@@ -117,15 +117,6 @@ def by_content(head: bytes, size: int | None) -> MeshFormat | None:
     return next((fmt for fmt in ranked if fmt.signature(head, size)), None)
 
 
-def markdown_table() -> str:
-    """The formats as the README's Markdown table (a test keeps the two equal)."""
-    rows = ["| format | extensions | reads and writes |", "|---|---|---|"]
-    for fmt in FORMATS.values():
-        rows.append(f"| `{fmt.name}` | {', '.join(f'`{e}`' for e in fmt.extensions)} | "
-                     f"{fmt.description} |")
-    return "\n".join(rows) + "\n"
-
-
 def _first_words(head: bytes) -> list[bytes]:
     """The first word of each of the first lines of ``head`` that hold anything but a
     comment (``#``), a byte-order mark skipped."""
