@@ -68,6 +68,30 @@ def test_the_options_table_is_the_settings_table():
     assert markdown_table() in Path(ROOT, "README.md").read_text(encoding="utf-8")
 
 
+def test_one_command_writes_every_generated_table_and_none_is_stale(tmp_path):
+    """docs/make_tables.py --check: the README's tables and the JSON Schema are what the
+    code generates; a stale copy is named (shown here on a README with a stale table)."""
+    import subprocess
+    import sys
+
+    p = subprocess.run([sys.executable, os.path.join(ROOT, "docs", "make_tables.py"),
+                        "--check"], capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert p.returncode == 0, p.stdout
+    sys.path.insert(0, os.path.join(ROOT, "docs"))
+    try:
+        import make_tables
+    finally:
+        sys.path.pop(0)
+    text = Path(ROOT, "README.md").read_text(encoding="utf-8")
+    stale = text.replace("| `vtu` | `.vtu` |", "| `vtu` | `.vtx` |")
+    assert stale != text and make_tables.replace_table(stale, _formats_table()) == text
+
+
+def _formats_table():
+    from srarap_cli.io.mesh.meshio_formats import markdown_table
+    return markdown_table()
+
+
 def test_the_formats_table_is_the_format_registry():
     from srarap_cli.io.mesh.meshio_formats import markdown_table
     assert markdown_table() in Path(ROOT, "README.md").read_text(encoding="utf-8")

@@ -1,0 +1,60 @@
+"""Every table the code generates, written where the docs show it: the README's settings table
+(from the settings table, ``srarap_cli.cli.options.markdown_table``) and format table (from
+the format registry, ``srarap_cli.io.mesh.meshio_formats.markdown_table``), and the handle
+files' JSON Schema (``docs/handles.schema.json``, ``srarap_cli.io.handles.schema``).
+
+Run from the repository root after changing a setting, a format or the handle-file schema:
+
+    python docs/make_tables.py            # rewrite what changed
+    python docs/make_tables.py --check    # exit 1, naming the stale files, if any is stale
+
+tests/test_readme.py runs ``--check``.
+"""
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+README = os.path.join(ROOT, "README.md")
+SCHEMA = os.path.join(HERE, "handles.schema.json")
+
+
+def replace_table(text: str, table: str) -> str:
+    """``text`` with the Markdown table that has ``table``'s header line replaced by it."""
+    header = table.splitlines()[0]
+    start = text.index(header)
+    end = text.find("\n\n", start)
+    end = len(text) if end < 0 else end + 1
+    return text[:start] + table + text[end:]
+
+
+def generated() -> dict[str, str]:
+    """path -> the content it should have."""
+    from srarap_cli.cli.options import markdown_table as settings_table
+    from srarap_cli.io.handles.schema import schema_text
+    from srarap_cli.io.mesh.meshio_formats import markdown_table as formats_table
+
+    with open(README, encoding="utf-8") as fh:
+        readme = fh.read()
+    for table in (settings_table(), formats_table()):
+        readme = replace_table(readme, table)
+    return {README: readme, SCHEMA: schema_text()}
+
+
+def main(argv: list[str]) -> int:
+    stale = []
+    for path, text in generated().items():
+        with open(path, encoding="utf-8") as fh:
+            if fh.read() == text:
+                continue
+        stale.append(os.path.relpath(path, ROOT))
+        if "--check" not in argv:
+            with open(path, "w", encoding="utf-8") as fh:
+                fh.write(text)
+    if stale:
+        print(("stale: " if "--check" in argv else "wrote: ") + ", ".join(stale))
+    return 1 if stale and "--check" in argv else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
