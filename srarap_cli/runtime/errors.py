@@ -16,7 +16,7 @@ class NumericalError(RuntimeError):
 
 
 class SingularSystemError(RuntimeError):
-    """A factorization met a singular matrix (for example a part with no constraint)."""
+    """A factorization met a singular matrix (degenerate geometry)."""
 
 
 class UsageProblem(ValueError):

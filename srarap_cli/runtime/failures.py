@@ -42,7 +42,7 @@ def classify(exc: BaseException, written: str = "") -> tuple[int, str]:
     if isinstance(exc, SingularSystemError | np.linalg.LinAlgError):
         return exit_codes.NUMERICAL_FAILURE, (
             f"singular system ({exc}): degenerate geometry (coincident or collinear vertices, "
-            f"zero-area triangles) or a part with no constraint{tail}")
+            f"zero-area triangles){tail}")
     if isinstance(exc, OSError):  # a file operation the checks before it did not foresee
         where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
         return exit_codes.OUTPUT_ERROR, f"{where}{exc.strerror or exc}"
