@@ -81,7 +81,8 @@ COMMANDS = ["deform", "info", "info with handles", "compare", "compare, second",
             "animate", "bench"]
 
 
-@pytest.mark.parametrize("command", COMMANDS)
+@pytest.mark.parametrize("command", [pytest.param(c, marks=[pytest.mark.slow] if c == "bench"
+                                                  else []) for c in COMMANDS])
 def test_every_command_gives_0_2_or_4_and_one_line_for_any_mesh_path(paths, command,
                                                                       tmp_path):
     for name, (path, allowed) in paths.items():

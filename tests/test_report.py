@@ -195,6 +195,7 @@ def test_compare_names_where_the_difference_is_and_writes_its_report(tmp_path):
     assert "distance to the golden mesh" in (tmp_path / "c.html").read_text()
 
 
+@pytest.mark.slow  # starts a browser
 def test_a_report_of_100_jobs_stays_small_and_opens_in_a_browser(run, tmp_path):
     tmp, _ = run
     html = (tmp / "out" / "report.html").read_text()
