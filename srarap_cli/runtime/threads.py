@@ -250,7 +250,7 @@ def end_children(pid: int, grace: float = CHILD_GRACE) -> None:
         for child in children:
             try:
                 os.kill(child, sig)
-            except OSError:
+            except OSError:  # it ended by itself meanwhile
                 pass
         deadline = time.monotonic() + grace
         while children and time.monotonic() < deadline:
@@ -273,7 +273,7 @@ def _children(pid: int) -> list[int]:
         try:
             with open(f"/proc/{entry}/stat", "rb") as fh:
                 fields = fh.read().rsplit(b")", 1)[1].split()
-        except OSError:
+        except OSError:  # the process ended while the list was read
             continue
         if int(fields[1]) == pid and fields[0] != b"Z":
             found.append(int(entry))

@@ -4,6 +4,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from ..io.handles import Constraints
+from ..io.handles.transforms import vector_text
 from ..io.mesh import Mesh
 from ..solver.group_rotations import group_rotors
 from ..solver.mesh_checks import edge_adjacency, edge_counts, mesh_warnings
@@ -100,7 +101,7 @@ def describe_motion(rest: np.ndarray, targets: np.ndarray) -> str:
         shift = targets.mean(axis=0) - rest.mean(axis=0)
         if np.abs(rest + shift - targets).max() <= 1e-9 * max(np.ptp(rest, axis=0).max(),
                                                               1e-300):
-            return f"translate {_vec(shift)}"
+            return f"translate {vector_text(shift)}"
         return (f"moves its vertices by up to {moved:.6g} (they lie on a line: the rotation "
                 "is not determined by them)")
     q = q[0]
@@ -108,13 +109,12 @@ def describe_motion(rest: np.ndarray, targets: np.ndarray) -> str:
     angle = float(np.degrees(2 * np.arctan2(np.linalg.norm(q[1:]), q[0])))
     scale = max(np.abs(rest).max(), 1.0)
     c, d = rest.mean(axis=0), targets.mean(axis=0) - rest.mean(axis=0)
-    c[np.abs(c) < 1e-12 * scale] = 0.0  # rounding noise of a centroid on an axis
     words = []
     if angle > 1e-9:
         axis = q[1:] / np.linalg.norm(q[1:])
-        words.append(f"rotate {angle:.6g} degrees about {_direction(axis)} through {_vec(c)}")
+        words.append(f"rotate {angle:.6g} degrees about {_direction(axis)} through {vector_text(c, scale)}")
     if np.linalg.norm(d) > 1e-12 * scale:
-        words.append(f"translate {_vec(d)}")
+        words.append(f"translate {vector_text(d)}")
     text = ", then ".join(words) or "fixed"
     if determined.all():
         R = to_matrix(q)
@@ -146,11 +146,7 @@ def _direction(axis):
     k = int(np.argmax(np.abs(axis)))
     if np.abs(axis[k]) > 1 - 1e-9:
         return ("+" if axis[k] > 0 else "-") + AXES[k]
-    return _vec(axis)
-
-
-def _vec(v):
-    return "(" + ", ".join(f"{x + 0.0:.6g}" for x in v) + ")"
+    return vector_text(axis)
 
 
 def _components(F, n):

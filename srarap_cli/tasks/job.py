@@ -13,7 +13,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..io.mesh.formats import MeshFormat, by_extension, extensions
+from ..io.mesh.formats import FORMATS, MeshFormat, by_extension, extensions
 from ..io.solve_log import LOG_FORMATS, format_log
 from ..runtime import descriptors, memory
 from ..runtime.commit import commit_files
@@ -88,9 +88,10 @@ def run_job(job: DeformJob, callback: Callable[[dict], None] | None = None,
     """
     start = time.perf_counter()
     fmt = _preflight(job)
-    result = recorded_result(job) if job.record else None
+    key = _key(job) if job.record else None  # of the inputs as they were when the job began
+    result = recorded_result(job, key) if key is not None else None
     if result is None:
-        result = _solve(job, fmt, callback, write_stdout)
+        result = _solve(job, fmt, callback, write_stdout, key)
     if job.expect is not None and result.status is not JobStatus.NOT_CONVERGED \
             and os.path.exists(job.output):
         check_golden(result, job.expect, job.output)
@@ -144,8 +145,6 @@ def _output_format(job):
 
 
 def _check_format_options(fmt, job):
-    from ..io.mesh import FORMATS
-
     def having(attribute):
         return "/".join(f.name.upper() for f in FORMATS.values() if getattr(f, attribute))
 
@@ -155,10 +154,14 @@ def _check_format_options(fmt, job):
         raise UsageProblem(f"--write-distortion needs a {having('keeps_vertex_data')} output")
 
 
-def recorded_result(job: DeformJob) -> JobResult | None:
-    """The result an unchanged job's record gives, or None (the job runs)."""
-    key = fingerprint(job.mesh, job.handles, job.settings, os.path.basename(job.output))
-    rec = read_record(sidecar_path(job.output), key)
+def _key(job):
+    return fingerprint(job.mesh, job.handles, job.settings, os.path.basename(job.output))
+
+
+def recorded_result(job: DeformJob, key: str | None = None) -> JobResult | None:
+    """The result an unchanged job's record gives, or None (the job runs); ``key``: the
+    job's fingerprint, when already computed."""
+    rec = read_record(sidecar_path(job.output), key or _key(job))
     if rec is None:
         return None
     status = JobStatus(rec["status"])
@@ -173,7 +176,7 @@ def recorded_result(job: DeformJob) -> JobResult | None:
                      else "inputs unchanged since the recorded run")
 
 
-def _solve(job, fmt, callback, write_stdout):
+def _solve(job, fmt, callback, write_stdout, key):
     peaks: dict[str, int | None] = {}
     peak = memory.start()
     source, source_format = read_any_mesh(job.mesh, job.input_format)
@@ -197,8 +200,7 @@ def _solve(job, fmt, callback, write_stdout):
     status = JobStatus.OK if solve.complete else JobStatus.NOT_CONVERGED
     keep = solve.complete or job.keep_unconverged
     files = _files(job, keep, mesh_bytes, deformed, source, constraints, solve)
-    if job.record:
-        key = fingerprint(job.mesh, job.handles, job.settings, os.path.basename(job.output))
+    if key is not None:
         files.append((sidecar_path(job.output), record_bytes(
             key, status.value, solve.iterations, solve.energy, solve.stop_reason.value,
             notes + lost)))

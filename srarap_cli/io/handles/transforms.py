@@ -219,7 +219,7 @@ def describe_action(spec: dict, rest: np.ndarray) -> str:
     if "matrix" in spec:
         M = spec["matrix"]
         return f"matrix from {M}" if isinstance(M, str) else "matrix " + "; ".join(
-            _vec(row) for row in np.asarray(M, float).reshape(4, 4)[:3])
+            vector_text(row) for row in np.asarray(M, float).reshape(4, 4)[:3])
     words = []
     if "rotate" in spec:
         rot = spec["rotate"]
@@ -228,17 +228,17 @@ def describe_action(spec: dict, rest: np.ndarray) -> str:
             q = _scaled(np.asarray(rot[key], float)[QUATERNION_KEYS[key]])
             q = q / np.linalg.norm(q) * (1 if q[0] >= 0 else -1)
             angle = float(np.degrees(2 * np.arctan2(np.linalg.norm(q[1:]), q[0])))
-            turn = (f"rotate {_num(angle)} degrees about {_vec(q[1:] / np.linalg.norm(q[1:]))} "
-                    f"({key} {_vec(rot[key])})" if angle > 1e-9 else "")
+            turn = (f"rotate {_num(angle)} degrees about {vector_text(q[1:] / np.linalg.norm(q[1:]))} "
+                    f"({key} {vector_text(rot[key])})" if angle > 1e-9 else "")
         else:
             unit = {"angle_deg": "degrees", "angle_rad": "radians", "angle": "degrees"}[key]
-            turn = f"rotate {_num(rot[key])} {unit} ({key}) about axis {_vec(rot['axis'])}"
-        pivot = (f"through {_vec(spec['pivot'])}" if "pivot" in spec else
-                 f"through the group's centroid {_vec(rest.mean(axis=0), np.abs(rest).max())}")
+            turn = f"rotate {_num(rot[key])} {unit} ({key}) about axis {vector_text(rot['axis'])}"
+        pivot = (f"through {vector_text(spec['pivot'])}" if "pivot" in spec else
+                 f"through the group's centroid {vector_text(rest.mean(axis=0), np.abs(rest).max())}")
         if turn:
             words.append(f"{turn} {pivot}")
     if "translate" in spec:
-        words.append(f"translate {_vec(spec['translate'])}")
+        words.append(f"translate {vector_text(spec['translate'])}")
     return ", then ".join(words) or "fixed"
 
 
@@ -248,7 +248,15 @@ def _num(x, scale=1.0):
     return f"{(0.0 if abs(x) < 1e-12 * scale else x) + 0.0:.6g}"
 
 
-def _vec(v, scale=None):
+def vector_text(v: np.ndarray, scale: float | None = None) -> str:
+    """``(x, y, z)`` in 6 digits, rounding noise below 1e-12 of ``scale`` (default the
+    largest component) written 0.
+
+    Examples
+    --------
+    >>> vector_text(np.array([1.0, -1.6e-16, 2.5]))
+    '(1, 0, 2.5)'
+    """
     v = np.asarray(v, float).ravel()
     scale = float(np.abs(v).max(initial=0)) if scale is None else float(scale)
     return "(" + ", ".join(_num(x, scale) for x in v) + ")"

@@ -133,7 +133,9 @@ def _is_ply(head: bytes, size: int | None) -> bool:
     return re.match(rb"(\xef\xbb\xbf)?ply\r?\n", head) is not None
 
 
-def _is_binary_stl(head: bytes, size: int | None) -> bool:
+def is_binary_stl(head: bytes, size: int | None) -> bool:
+    """Whether content starting with ``head`` is binary STL: its size is 84 + 50 x its
+    triangle count, or, on a stream (``size`` None), its first records are numbers."""
     if len(head) < 84 or (size is not None and size < 84):
         return False
     count = int(np.frombuffer(head[80:84], "<u4")[0])
@@ -158,11 +160,11 @@ def _is_ascii_stl(head: bytes, size: int | None) -> bool:
     words = _first_words(head)
     # on a stream (size None) either variant is STL: the reader tells them apart by the size
     return bool(words) and words[0].lower() == b"solid" and (
-        size is None or not _is_binary_stl(head, size))
+        size is None or not is_binary_stl(head, size))
 
 
 def _is_stl(head: bytes, size: int | None) -> bool:
-    return _is_binary_stl(head, size) or _is_ascii_stl(head, size)
+    return is_binary_stl(head, size) or _is_ascii_stl(head, size)
 
 
 def _is_off(head: bytes, size: int | None) -> bool:

@@ -11,7 +11,7 @@ import numpy as np
 from ...runtime import descriptors
 from ...runtime.errors import InputError
 from ...runtime.limits import available_memory, check_read_size
-from .formats import FORMATS, HEAD_BYTES, MeshFormat, by_content
+from .formats import FORMATS, HEAD_BYTES, MeshFormat, by_content, is_binary_stl
 from .mesh import Mesh
 from .sniff import not_a_mesh
 
@@ -65,7 +65,7 @@ def _head(stream, name):
 def _spool(stream, path, head, fmt, have, name):
     """Copy ``head`` and the rest of ``stream`` to ``path``; returns the size."""
     room = shutil.disk_usage(os.path.dirname(path)).free - TMP_RESERVE
-    most = _binary_stl_size(head) if fmt.name == "stl" else None
+    most = _binary_stl_size(head) if fmt.name == "stl" and is_binary_stl(head, None) else None
     total = len(head)
     with open(path, "wb") as out:
         out.write(head)
@@ -77,7 +77,7 @@ def _spool(stream, path, head, fmt, have, name):
                                  f"{os.path.dirname(os.path.dirname(path))} can keep "
                                  f"({max(room, 0) / 1e9:.2f} GB free); set TMPDIR to a "
                                  "folder with room, or give the mesh as a file")
-            if most is not None and total > most and not _is_text(head):
+            if most is not None and total > most:
                 raise InputError(f"{name}: not a mesh: longer than the {(most - 84) // 50} "
                                  "triangles a binary STL header there gives")
             out.write(chunk)
@@ -89,10 +89,6 @@ def _binary_stl_size(head):
     if len(head) < 84:
         return None
     return 84 + 50 * int(np.frombuffer(head[80:84], "<u4")[0])
-
-
-def _is_text(head):
-    return all(b >= 9 for b in head[84:1024])
 
 
 def _read(stream, size, name):
