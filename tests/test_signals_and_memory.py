@@ -84,6 +84,44 @@ def test_a_signal_some_library_swallowed_is_still_reported(case):
     assert err.splitlines()[-1] == "srarap: error: terminated; stopped after writing o.obj"
 
 
+@pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated"),
+                                             (signal.SIGINT, 130, "interrupted")])
+def test_a_signal_inside_a_finalizer_still_stops_the_run(case, sig, code, word):
+    """Raised inside a finalizer (as in a weakref callback of the import system, seen once in
+    CI), the signal's exception cannot leave it: Python printed "Exception ignored in" with
+    a traceback, and the run went on to write its output."""
+    patch = ("import srarap_cli.tasks.pipeline as pl\nreal = pl.problem\n"
+             "class Dropped:\n"
+             "    def __del__(self):\n"
+             f"        os.kill(os.getpid(), {int(sig)}); time.sleep(0.5)\n"
+             "def dropping(*a, **k):\n"
+             "    Dropped()\n"
+             "    return real(*a, **k)\n"
+             "pl.problem = dropping\n")
+    p = _start(case, patch, "deform", "m.obj", "h.yaml", "-o", "o.obj")
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == code, err
+    assert err == f"srarap: error: {word}; no output written\n"
+    assert (case / "o.obj").read_text() == "old result\n"
+
+
+def test_a_signal_inside_the_import_system_is_raised_once_outside_it():
+    """Raised in the import system's own frames, the exception could leave its lock held."""
+    code = ("import signal, sys, time\nfrom srarap_cli.runtime import signals\nsignals.own()\n"
+            "ns = {}\nexec(compile('import sys\\ndef here():\\n    return sys._getframe()\\n',"
+            " '<frozen importlib._bootstrap>', 'exec'), ns)\n"
+            "try:\n"
+            "    signals._on_signal(signal.SIGINT, ns['here']())\n"
+            "    print('returned')\n"
+            "    time.sleep(30)\n"
+            "except KeyboardInterrupt:\n"
+            "    print('raised')\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60)
+    assert done.stdout.split() == ["returned", "raised"], done.stderr
+    assert done.stderr == ""
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("delay", [0.2, 0.5, 0.8])
 def test_a_signal_during_the_simplification_with_the_setup_beside_it(case, delay):

@@ -14,6 +14,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from typing import Any, NoReturn
 
@@ -32,12 +33,59 @@ class Terminated(BaseException):
     """SIGTERM arrived; raised so that cleanup (temporary files) runs on the way out."""
 
 
-def _on_signal(signum, _frame):
+#: set while :func:`_on_unraisable` runs: a signal's handler must not raise there
+_IN_HOOK = False
+
+
+def _on_signal(signum, frame):
     global RECEIVED
     RECEIVED = RECEIVED or signum
+    if _IN_HOOK or _in_import_machinery(frame):
+        # raised inside the import system, the exception could leave the import lock held
+        # (a weakref callback that takes it) and is printed as "Exception ignored in"
+        _send_again(signum)
+        return
     if signum == signal.SIGINT:
         raise KeyboardInterrupt()
     raise Terminated()
+
+
+def _in_import_machinery(frame) -> bool:
+    return frame is not None and frame.f_code.co_filename.startswith("<frozen importlib")
+
+
+def _send_again(signum: int) -> None:
+    """The signal again to the main thread in a moment, from another thread: its handler then
+    runs at the interpreter's next check, which is past the place it could not raise in (or
+    it is sent again). Anything that tripped the handler from here, in this thread, would run
+    it here at once."""
+    threading.Thread(target=_send_later, args=(signum,), daemon=True).start()
+
+
+def _send_later(signum: int) -> None:
+    time.sleep(0.005)
+    signal.pthread_kill(threading.main_thread().ident, signum)
+
+
+#: the hook that had been set before :func:`_route` (a test runner's), for everything else
+_other_hook = sys.unraisablehook
+_SIGNAL_OF = {KeyboardInterrupt: signal.SIGINT, Terminated: signal.SIGTERM}
+
+
+def _on_unraisable(unraisable) -> None:
+    """A signal's exception raised inside a finalizer or a weakref callback cannot leave it:
+    Python printed "Exception ignored in" with a traceback and the signal was lost (the batch
+    went on)."""
+    global _IN_HOOK
+    signum = _SIGNAL_OF.get(type(unraisable.exc_value))
+    if signum is None or threading.current_thread() is not threading.main_thread():
+        _other_hook(unraisable)
+        return
+    _IN_HOOK = True
+    try:
+        _send_again(signum)
+    finally:
+        _IN_HOOK = False
 
 
 def own() -> None:
@@ -52,6 +100,9 @@ def _route() -> dict[int, Any]:
     the handlers they replaced."""
     if threading.current_thread() is not threading.main_thread():
         return {}
+    global _other_hook
+    if sys.unraisablehook is not _on_unraisable:
+        _other_hook, sys.unraisablehook = sys.unraisablehook, _on_unraisable
     return {signum: signal.signal(signum, _on_signal) for signum in SIGNALS}
 
 
@@ -62,11 +113,13 @@ def routed() -> Iterator[None]:
     handlers come back after it: left in place, a SIGTERM meant to end the host later raised
     :class:`Terminated` wherever the host happened to be (a pytest-xdist worker printed a
     traceback and stayed alive)."""
+    hook = sys.unraisablehook
     before = _route()
     try:
         yield
     finally:
         if not OWNED:
+            sys.unraisablehook = hook
             for signum, handler in before.items():
                 signal.signal(signum, handler if handler is not None else signal.SIG_DFL)
 
