@@ -1,4 +1,5 @@
-"""Both factorization back ends solve the same systems."""
+"""The factorization paths (rslab; SuperLU in nested-dissection or minimum-degree order) solve
+the same systems. SuperLU's own tests ask for it through $SRARAP_FACTOR."""
 import igl
 import numpy as np
 import pytest
@@ -6,11 +7,25 @@ import scipy.sparse as sp
 from helpers import ends, tube
 
 from srarap_cli import Deformer
-from srarap_cli.solver import linalg
+from srarap_cli.solver import linalg, one_triangle
 from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 
+PATHS = ["nested dissection", "minimum degree", "rslab"]
 
-def test_nested_dissection_back_end_solves_spd_systems(monkeypatch):
+
+@pytest.fixture
+def superlu(monkeypatch):
+    monkeypatch.setenv(one_triangle.ENV, "superlu")
+
+
+def _use(path, monkeypatch):
+    if path != "rslab":
+        monkeypatch.setenv(one_triangle.ENV, "superlu")
+    if path == "nested dissection":
+        monkeypatch.setattr(linalg, "LARGE", 0)
+
+
+def test_nested_dissection_back_end_solves_spd_systems(monkeypatch, superlu):
     rng = np.random.default_rng(1)
     M = sp.random(30, 30, density=0.2, random_state=2)
     A = (M @ M.T + sp.eye(30) * 0.5).tocsr()
@@ -22,7 +37,7 @@ def test_nested_dissection_back_end_solves_spd_systems(monkeypatch):
     assert solve(b[:, 0]).shape == (30,)
 
 
-def test_large_mesh_back_end_gives_the_same_deformation(monkeypatch):
+def test_large_mesh_back_end_gives_the_same_deformation(monkeypatch, superlu):
     V, F = tube(length=6.0, rings=12, segments=8)
     ids = ends(V, 6.0)
     T = V[ids].copy()
@@ -51,6 +66,7 @@ def test_nested_dissection_back_end_is_deterministic_across_processes():
         "import sys, hashlib; sys.path.insert(0, 'tests')\n"
         "from helpers import ends, tube\n"
         "from srarap_cli import Deformer\n"
+        "import os; os.environ['SRARAP_FACTOR'] = 'superlu'\n"
         "from srarap_cli.solver import linalg\n"
         "linalg.LARGE = 0\n"
         "V, F = tube(length=10.0, rings=30, segments=16)\n"
@@ -64,7 +80,7 @@ def test_nested_dissection_back_end_is_deterministic_across_processes():
 
 
 def test_one_nested_dissection_serves_the_poisson_matrix_and_the_rotor_preconditioner(
-        monkeypatch):
+        monkeypatch, superlu):
     """Their free vertices differ (the rotor system keeps a handle's interior), yet one METIS
     run of the mesh graph, restricted to each matrix's rows, orders both."""
     import pymetis
@@ -94,13 +110,13 @@ def test_restricted_order_is_the_mesh_order_of_the_rows():
     assert np.all(np.diff(rank[rows[sub]]) > 0)
 
 
-@pytest.mark.parametrize("large", [0, linalg.LARGE])  # nested dissection, minimum degree
-def test_an_approximate_factor_is_single_precision_and_answers_in_double(monkeypatch, large):
+@pytest.mark.parametrize("path", PATHS)
+def test_an_approximate_factor_is_single_precision_and_answers_in_double(monkeypatch, path):
     rng = np.random.default_rng(3)
     M = sp.random(40, 40, density=0.2, random_state=4)
     A = (M @ M.T + sp.eye(40)).tocsr()
     b = rng.standard_normal((40, 4))
-    monkeypatch.setattr(linalg, "LARGE", large)
+    _use(path, monkeypatch)
     x = linalg.factor(A, symmetric=True, approximate=True)(b)
     exact = linalg.factor(A, symmetric=True)(b)
     assert x.dtype == np.float64
@@ -109,18 +125,18 @@ def test_an_approximate_factor_is_single_precision_and_answers_in_double(monkeyp
 
 
 
-@pytest.mark.parametrize("large", [0, linalg.LARGE])
+@pytest.mark.parametrize("path", PATHS)
 @pytest.mark.parametrize("matrix_scale, rhs_scale", [(1e-45, 1.0), (1e40, 1.0), (1.0, 1e-300),
                                                      (1e-30, 1e200), (1e35, 1e-40)])
 def test_an_approximate_factor_solves_at_scales_single_precision_cannot_hold(
-        monkeypatch, large, matrix_scale, rhs_scale):
+        monkeypatch, path, matrix_scale, rhs_scale):
     # a mesh in other units scales its matrices: 1e-45 and 1e40 lie outside float32's range
     # (and 1e-300 far below it), yet the solve must still be the exact one to single precision
     rng = np.random.default_rng(5)
     M = sp.random(40, 40, density=0.2, random_state=6)
     A = (M @ M.T + sp.eye(40)).tocsr()
     b = rng.standard_normal((40, 4))
-    monkeypatch.setattr(linalg, "LARGE", large)
+    _use(path, monkeypatch)
     x = linalg.factor(A * matrix_scale, symmetric=True, approximate=True)(b * rhs_scale)
     exact = linalg.factor(A, symmetric=True)(b) * (rhs_scale / matrix_scale)
     assert np.isfinite(x).all()

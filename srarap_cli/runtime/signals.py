@@ -64,7 +64,9 @@ def _send_again(signum: int) -> None:
 
 def _send_later(signum: int) -> None:
     time.sleep(0.005)
-    signal.pthread_kill(threading.main_thread().ident, signum)
+    main = threading.main_thread().ident
+    if main is not None:  # always, once the main thread started
+        signal.pthread_kill(main, signum)
 
 
 #: the hook that had been set before :func:`_route` (a test runner's), for everything else

@@ -13,6 +13,7 @@ from ..runtime.fresh_process import run_fresh
 from ..runtime.limits import is_out_of_memory
 from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
+from .one_triangle import rslab_factor
 
 # Above this size SuperLU's minimum-degree ordering is what takes the time (on the 738k-vertex
 # Laplacian it had not finished after 12 minutes). METIS's nested dissection orders it in 7 s
@@ -46,9 +47,11 @@ _warm_blas()
 
 def factor(A: csr_matrix, symmetric: bool, order: Callable | None = None, approximate: bool = False
            ) -> Callable:
-    """LU-factor a sparse square matrix; returns a callable ``solve(b)``.
+    """Factor a sparse square matrix; returns a callable ``solve(b)``.
 
-    A symmetric matrix gets a symmetric fill-reducing ordering, which roughly halves the
+    A symmetric positive definite matrix is factored by rslab (:mod:`.one_triangle`: one
+    stored triangle, half SuperLU's memory, faster) where it can be; everything else by
+    SuperLU. For SuperLU, a symmetric matrix gets a symmetric fill-reducing ordering, which roughly halves the
     fill of SuperLU's default column ordering on mesh Laplacians, and SuperLU's symmetric
     mode (diagonal pivots preferred): with the same fill, its triangular solves ran 1.5 to 4
     times faster on the benchmark meshes (decimated-max Laplacian: 2.0 -> 0.5 ms).
@@ -77,7 +80,12 @@ def factor(A: csr_matrix, symmetric: bool, order: Callable | None = None, approx
         # single precision spans 1e-38 to 3e38 only: the matrix (and each right-hand side,
         # in the solve) brought to unit size keep meshes of any units inside it
         scale = float(abs(A).max()) or 1.0
-        A = (A / scale).astype(np.float32)
+        A = A / scale
+    ldlt = rslab_factor(A, single=approximate) if symmetric else None
+    if ldlt is not None:
+        return _rslab_solver(ldlt, scale, approximate)
+    if symmetric and approximate:
+        A = A.astype(np.float32)
     if symmetric and A.shape[0] > LARGE:
         return _nested_dissection(A, fill_order(A) if order is None else order(), scale)
     options = {"SymmetricMode": True} if symmetric else {}
@@ -138,6 +146,22 @@ def _solver(lu, dtype, scale=1.0):
         with _flushed(True):
             X = lu.solve(B)
         return np.multiply(X, size / scale, dtype=float)
+
+    return solve
+
+
+def _rslab_solver(ldlt, scale, single):
+    """``solve(b)`` of ``scale`` times the matrix factored into ``ldlt``, in double precision.
+    A single-precision factor gets each right-hand side brought to unit size, as SuperLU's."""
+
+    def solve(b):
+        b = np.ascontiguousarray(b, dtype=float)
+        size = max(float(b.max(initial=0.0)), -float(b.min(initial=0.0))) if single else 1.0
+        if size == 0.0:
+            return np.zeros(b.shape)
+        B = b / size if single else b
+        X = ldlt.solve_many(B) if B.ndim == 2 else ldlt.solve(B)
+        return X * (size / scale) if single or scale != 1.0 else X
 
     return solve
 
