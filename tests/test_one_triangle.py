@@ -156,3 +156,25 @@ def test_rslab_solves_are_deterministic_across_processes():
     digests = {subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True,
                               text=True, check=True, env=env).stdout for _ in range(2)}
     assert len(digests) == 1 and len(next(iter(digests)).strip()) == 64
+
+
+def test_a_multiresolution_deform_whose_first_factorization_runs_in_the_background(tmp_path):
+    """The full-resolution setup (the process's first factorization) runs in a thread beside
+    the simplification: rslab's allocator, set up there first, crashed the process (SIGSEGV,
+    every run from 20,000 vertices, where coarse-to-fine begins) until the solver's import
+    set it up in the main thread."""
+    from helpers import tube_mesh
+
+    from srarap_cli.io.mesh import write_mesh
+
+    write_mesh(str(tmp_path / "m.obj"), tube_mesh(length=10.0, rings=200, segments=128))
+    (tmp_path / "h.yaml").write_text(
+        "groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
+        "  tip: {box: {min: [-2, -2, 9.99], max: [2, 2, 10.01]}, rotate: "
+        "{axis: [0, 1, 0], angle_deg: 40}}\n")
+    env = {k: v for k, v in os.environ.items() if k != one_triangle.ENV}
+    done = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "m.obj", "h.yaml",
+                           "-o", "o.obj", "--max-iter", "3", "--keep-unconverged"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode in (0, 3), done.stderr[-800:]
+    assert "coarse" in done.stderr and (tmp_path / "o.obj").exists()

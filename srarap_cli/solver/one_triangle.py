@@ -121,3 +121,17 @@ def _module():
     except ImportError:
         return None
     return rslab
+
+
+def _start() -> None:
+    """Load rslab and have it allocate once, in the thread that imports the solver (the main
+    one). rslab brings its own allocator (mimalloc), which sets itself up on first use: first
+    used in the multiresolution setup's background thread while the main thread simplified,
+    it crashed the process (SIGSEGV in ``mi_thread_init``, 500k-vertex bar, every run)."""
+    rslab = _module() if backend() == "rslab" else None
+    if rslab is not None:
+        with held_c_stderr():
+            rslab.ldlt(csr_matrix(np.eye(2)), ordering="amd", threads=1)
+
+
+_start()
