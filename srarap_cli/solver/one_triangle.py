@@ -40,6 +40,7 @@ SPARE = 2
 SPARE_BYTES = 256_000_000
 #: what rslab's analysis takes per stored entry, with a margin (22 measured on a grid)
 ANALYSIS_BYTES_PER_ENTRY = 64
+_STARTED = False
 #: the process that first used rslab (0: none): a child forked from it must not
 _USED_IN = 0
 
@@ -123,15 +124,17 @@ def _module():
     return rslab
 
 
-def _start() -> None:
-    """Load rslab and have it allocate once, in the thread that imports the solver (the main
-    one). rslab brings its own allocator (mimalloc), which sets itself up on first use: first
-    used in the multiresolution setup's background thread while the main thread simplified,
-    it crashed the process (SIGSEGV in ``mi_thread_init``, 500k-vertex bar, every run)."""
-    rslab = _module() if backend() == "rslab" else None
+def start() -> None:
+    """Load rslab and have it allocate once, in this thread, before a background thread may
+    factor (the multiresolution setup calls it). Not at import: a fork server that imports
+    the solver would then fork its workers from a process rslab had used. rslab brings its
+    own allocator (mimalloc), which sets itself up on first use: first used in the
+    multiresolution setup's background thread while the main thread simplified, it crashed
+    the process (SIGSEGV in ``mi_thread_init``, 500k-vertex bar, every run)."""
+    global _STARTED
+    rslab = _module() if backend() == "rslab" and not _STARTED else None
     if rslab is not None:
+        _STARTED = True
         with held_c_stderr():
             rslab.ldlt(csr_matrix(np.eye(2)), ordering="amd", threads=1)
 
-
-_start()
