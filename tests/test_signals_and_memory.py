@@ -69,15 +69,18 @@ def test_a_signal_while_the_process_ends_still_gives_its_code_and_the_truth(case
     assert (case / "o.obj").read_text().startswith(("v ", "#"))  # the complete new file
 
 
+def _before_problem(body):
+    """A patch for :func:`_start` that runs ``body`` (indented source) as the pipeline builds
+    its problem, then builds it."""
+    return ("import srarap_cli.tasks.pipeline as pl\nreal = pl.problem\n"
+            f"def patched(*a, **k):\n{body}    return real(*a, **k)\npl.problem = patched\n")
+
+
 def test_a_signal_some_library_swallowed_is_still_reported(case):
-    patch = ("import srarap_cli.tasks.pipeline as pl\nreal = pl.problem\n"
-             "def swallowing(*a, **k):\n"
-             "    try:\n"
-             "        os.kill(os.getpid(), signal.SIGTERM); time.sleep(0.5)\n"
-             "    except BaseException:\n"
-             "        pass\n"
-             "    return real(*a, **k)\n"
-             "pl.problem = swallowing\n")
+    patch = _before_problem("    try:\n"
+                            "        os.kill(os.getpid(), signal.SIGTERM); time.sleep(0.5)\n"
+                            "    except BaseException:\n"
+                            "        pass\n")
     p = _start(case, patch, "deform", "m.obj", "h.yaml", "-o", "o.obj")
     _, err = p.communicate(timeout=60)
     assert p.returncode == 143, err
@@ -90,14 +93,10 @@ def test_a_signal_inside_a_finalizer_still_stops_the_run(case, sig, code, word):
     """Raised inside a finalizer (as in a weakref callback of the import system, seen once in
     CI), the signal's exception cannot leave it: Python printed "Exception ignored in" with
     a traceback, and the run went on to write its output."""
-    patch = ("import srarap_cli.tasks.pipeline as pl\nreal = pl.problem\n"
-             "class Dropped:\n"
+    patch = ("class Dropped:\n"
              "    def __del__(self):\n"
              f"        os.kill(os.getpid(), {int(sig)}); time.sleep(0.5)\n"
-             "def dropping(*a, **k):\n"
-             "    Dropped()\n"
-             "    return real(*a, **k)\n"
-             "pl.problem = dropping\n")
+             + _before_problem("    Dropped()\n"))
     p = _start(case, patch, "deform", "m.obj", "h.yaml", "-o", "o.obj")
     _, err = p.communicate(timeout=60)
     assert p.returncode == code, err
