@@ -99,7 +99,11 @@ def test_under_an_address_space_limit_rslab_gets_a_matrix_only_with_room_to_spar
     MB to spare), and rslab's threads may not get their stacks (a panic, printing a Rust
     backtrace): with little room, SuperLU takes the matrix, and solves it or reports a failed
     allocation as MemoryError (exit 4 in the command)."""
-    done = _run("import resource\n"
+    # OpenBLAS takes its buffer on first use and, under a limit, retries forever: linalg
+    # warms it at import when the limit is set before the process starts; here it comes after
+    done = _run("import resource\nfrom scipy.linalg import blas\n"
+                "one = np.ones((1, 1), order='F')\n"
+                "blas.dtrsv(one, np.ones(1)); blas.dgemm(1.0, one, one)\n"
                 "A = _grid(200); b = np.ones(40000)\n"
                 "mapped = int(open('/proc/self/status').read().split('VmSize:')[1].split()[0])\n"
                 f"resource.setrlimit(resource.RLIMIT_AS, (mapped * 1024 + {room},) * 2)\n"
@@ -115,13 +119,31 @@ def test_under_an_address_space_limit_rslab_gets_a_matrix_only_with_room_to_spar
     assert lines[0] == used and lines[1] in ("True", "MemoryError")
 
 
-def _run(script):
+def test_rslab_is_used_only_once_set_up_in_the_main_thread():
+    """First used in another thread, rslab's allocator crashed the process, at once or in the
+    main thread's next solve after that thread ended (seen under pytest-xdist). A process
+    where the solver's import did not set it up (srarap's fork server and its workers) gets
+    SuperLU from other threads until its main thread has."""
+    done = _run("import os, threading\n"
+                "got = []\n"
+                "t = threading.Thread(target=lambda: got.append(\n"
+                "    one_triangle.rslab_factor(_grid(50), single=False)))\n"
+                "t.start(); t.join()\n"
+                "one_triangle.start()\n"
+                "f = one_triangle.rslab_factor(_grid(60), single=False)\n"
+                "x = f.solve_many(np.ones((3600, 3)))\n"
+                "print(got == [None], np.isfinite(x).all())\n",
+                env={one_triangle.FORK_SERVER: "1"})
+    assert done.returncode == 0 and done.stdout.split() == ["True", "True"], done.stderr[-800:]
+
+
+def _run(script, env=None):
     """``script`` in a fresh interpreter, with numpy, ``_grid``, linalg and one_triangle."""
     head = ("import sys, numpy as np; sys.path.insert(0, 'tests')\n"
             "from test_one_triangle import _grid\n"
             "from srarap_cli.solver import linalg, one_triangle\n")
     return subprocess.run([sys.executable, "-c", head + script], cwd=ROOT, capture_output=True,
-                          text=True, timeout=120)
+                          text=True, timeout=120, env={**os.environ, **(env or {})})
 
 
 def _twisted_tube():

@@ -10,6 +10,7 @@ import os
 import resource
 
 from .errors import InputError
+from .memory import status_bytes
 
 # Measured on this project's machines (README, "Limits"): an SR solve takes about 4 KB per
 # vertex on a long bar, more where the factorizations fill in; this carries a safety margin.
@@ -54,6 +55,17 @@ def _system_available():
 def _address_space():
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     return None if soft == resource.RLIM_INFINITY else max(soft - ADDRESS_SPACE_BASE, 0)
+
+
+def address_space_left() -> int | None:
+    """Bytes the address-space limit (``ulimit -v``) leaves beyond what is mapped now; None
+    without a limit. 0 where the mappings cannot be read (not Linux): nothing is known to
+    fit."""
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft == resource.RLIM_INFINITY:
+        return None
+    mapped = status_bytes("VmSize")
+    return 0 if mapped is None else max(soft - mapped, 0)
 
 
 def _cgroup():

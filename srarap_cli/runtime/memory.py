@@ -29,16 +29,22 @@ def enable() -> None:
     _enabled = True
 
 
-def _high_water():
-    """``VmHWM`` in bytes, or None where it cannot be read."""
+def status_bytes(field: str) -> int | None:
+    """A size from ``/proc/self/status`` in bytes (``"VmHWM"``, ``"VmSize"``), or None where
+    it cannot be read."""
+    key = field.encode() + b":"
     try:
         with open(_STATUS, "rb") as f:
             for line in f:
-                if line.startswith(b"VmHWM:"):
+                if line.startswith(key):
                     return int(line.split()[1]) * 1024
     except (OSError, ValueError, IndexError):
         return None
     return None
+
+
+def _high_water():
+    return status_bytes("VmHWM")
 
 
 def _reset():

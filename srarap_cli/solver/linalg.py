@@ -152,18 +152,21 @@ def _solver(lu, dtype, scale=1.0):
 
 def _rslab_solver(ldlt, scale, single):
     """``solve(b)`` of ``scale`` times the matrix factored into ``ldlt``, in double precision.
-    A single-precision factor gets each right-hand side brought to unit size, as SuperLU's."""
+    A double-precision factor (``scale`` 1) solves as it is; a single-precision one gets each
+    right-hand side brought to unit size, as SuperLU's."""
 
-    def solve(b):
+    def exact(b):
         b = np.ascontiguousarray(b, dtype=float)
-        size = max(float(b.max(initial=0.0)), -float(b.min(initial=0.0))) if single else 1.0
+        return ldlt.solve_many(b) if b.ndim == 2 else ldlt.solve(b)
+
+    def approximate(b):
+        b = np.asarray(b, dtype=float)
+        size = max(float(b.max(initial=0.0)), -float(b.min(initial=0.0)))  # no |b| temporary
         if size == 0.0:
             return np.zeros(b.shape)
-        B = b / size if single else b
-        X = ldlt.solve_many(B) if B.ndim == 2 else ldlt.solve(B)
-        return X * (size / scale) if single or scale != 1.0 else X
+        return np.multiply(exact(b / size), size / scale)
 
-    return solve
+    return approximate if single else exact
 
 
 def _flushed(single):

@@ -11,8 +11,9 @@ half the memory, and orders and factors faster (1.2M-vertex cylinder Laplacian, 
   Lᵀ`` all the same; SuperLU then reports it as before);
 - rslab refused it or could not start its threads (under ``ulimit -v`` they may not get
   their stacks: it raises a Rust panic, whose text is held back);
-- this process was forked from one that had used rslab: its thread pool does not survive a
-  fork, and a factorization in the child waited forever (seen with one thread too).
+- rslab was not set up in this process's main thread (:func:`start`), or this process was
+  forked from one that had: its thread pool does not survive a fork, and a factorization
+  in the child waited forever (seen with one thread too).
 
 Its plan of the memory a factorization needs is checked against what the process may use
 first: a Rust allocation that fails ends the process (SIGABRT), where a refused plan is a
@@ -22,15 +23,16 @@ and OpenBLAS's buffers are in) and rslab gets a matrix only with :data:`SPARE` t
 there: SuperLU, which reports a failed allocation, takes it otherwise.
 """
 import os
-import resource
+import threading
 from typing import Any
 
 import numpy as np
 from scipy.sparse import csr_matrix
 
-from ..runtime.limits import available_memory
+from ..runtime.limits import address_space_left, available_memory
 from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
+from ..runtime.threads import FORK_SERVER
 
 ENV = "SRARAP_FACTOR"
 BACKENDS = ("rslab", "superlu")
@@ -40,9 +42,9 @@ SPARE = 2
 SPARE_BYTES = 256_000_000
 #: what rslab's analysis takes per stored entry, with a margin (22 measured on a grid)
 ANALYSIS_BYTES_PER_ENTRY = 64
-_STARTED = False
-#: the process that first used rslab (0: none): a child forked from it must not
-_USED_IN = 0
+#: the process in whose main thread rslab was set up (:func:`start`; 0: none). Only that
+#: process uses it: a child forked from it would hang, one never set up could crash
+_STARTED_IN = 0
 
 
 def backend() -> str:
@@ -63,13 +65,9 @@ def rslab_factor(A: csr_matrix, single: bool) -> Any:
     -------
     rslab.Ldlt or None; its ``solve_many(B)`` takes and returns (n, k) float64 arrays
     """
-    global _USED_IN
-    if backend() != "rslab" or (_USED_IN and _USED_IN != os.getpid()):
-        return None
-    rslab = _module()
+    rslab = _module() if backend() == "rslab" and _STARTED_IN == os.getpid() else None
     if rslab is None:
         return None
-    _USED_IN = _USED_IN or os.getpid()
     dtype = "float32" if single else "float64"
     try:
         with held_c_stderr():
@@ -104,15 +102,8 @@ def _check_memory(need: int, n: int) -> None:
 
 def _room_for(need: int) -> bool:
     """Whether the address space has room for a plan of ``need`` bytes and its threads."""
-    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
-    if soft == resource.RLIM_INFINITY:
-        return True
-    try:
-        with open("/proc/self/status") as fh:
-            mapped = int(fh.read().split("VmSize:")[1].split()[0]) * 1024
-    except (OSError, IndexError, ValueError):  # not Linux: no way to tell, SuperLU is safe
-        return False
-    return soft - mapped >= SPARE * need + SPARE_BYTES
+    left = address_space_left()
+    return left is None or left >= SPARE * need + SPARE_BYTES
 
 
 def _module():
@@ -125,16 +116,26 @@ def _module():
 
 
 def start() -> None:
-    """Load rslab and have it allocate once, in this thread, before a background thread may
-    factor (the multiresolution setup calls it). Not at import: a fork server that imports
-    the solver would then fork its workers from a process rslab had used. rslab brings its
-    own allocator (mimalloc), which sets itself up on first use: first used in the
-    multiresolution setup's background thread while the main thread simplified, it crashed
-    the process (SIGSEGV in ``mi_thread_init``, 500k-vertex bar, every run)."""
-    global _STARTED
-    rslab = _module() if backend() == "rslab" and not _STARTED else None
+    """Set rslab up in this process's main thread (elsewhere, or in a child forked from a
+    process that set it up, nothing happens, and :func:`rslab_factor` answers None there).
+
+    rslab brings its own allocator (mimalloc), which sets itself up on first use: first used
+    in a thread other than the main one, it crashed the process (SIGSEGV in
+    ``mi_thread_init`` as the multiresolution setup's background thread factored beside the
+    simplification; in the main thread's next solve after such a thread had ended). The
+    solver's import calls this, except in srarap's fork server (:data:`FORK_SERVER`): its
+    workers would be forked from a process with rslab's threads running, and hang. Those
+    workers set it up in their own main thread, as the multiresolution setup calls this
+    before its background thread starts."""
+    global _STARTED_IN
+    if _STARTED_IN or threading.current_thread() is not threading.main_thread():
+        return
+    rslab = _module() if backend() == "rslab" else None
     if rslab is not None:
-        _STARTED = True
         with held_c_stderr():
             rslab.ldlt(csr_matrix(np.eye(2)), ordering="amd", threads=1)
+        _STARTED_IN = os.getpid()
 
+
+if os.environ.get(FORK_SERVER) != "1":
+    start()

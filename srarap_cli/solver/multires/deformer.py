@@ -214,7 +214,7 @@ class MultiresDeformer:
         # (738k Spot: 50 s one after the other, 35 s side by side on two cores), and its
         # factorizations on beside the coarse setup and the first coarse solve (see _ready)
         built: Future[Deformer] = Future()
-        start_rslab()  # its allocator must be set up here, in this thread, first
+        start_rslab()  # in this thread, before the background one may factor
         self._prepared: Callable[[], float] | None = background(
             partial(self._fine_setup, area, built))
         try:
