@@ -28,9 +28,6 @@ T = TypeVar("T")
 F = TypeVar("F", bound=Callable[..., Any])
 
 _VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-#: set to "1" in srarap's fork server (and so in the workers it forks): libraries that start
-#: threads of their own must not be set up there before the fork (solver/one_triangle.py)
-FORK_SERVER = "SRARAP_FORK_SERVER"
 
 
 def single_threaded(func: F) -> F:
@@ -203,7 +200,7 @@ def _start_fork_server(preload):
     # user's concern: it cleans them up
     quiet = {"PYTHONWARNINGS": ",".join(filter(None, [
         os.environ.get("PYTHONWARNINGS"), "ignore::UserWarning:multiprocessing.resource_tracker"]))}
-    with environ_changed({**dict.fromkeys(_VARIABLES, "1"), FORK_SERVER: "1", **quiet}):
+    with environ_changed({**dict.fromkeys(_VARIABLES, "1"), **quiet}):
         # the server starts with SIGINT/SIGTERM held back (the mask outlives exec) until
         # its preload has set them: a Ctrl-C during its imports printed their traceback.
         # Python's resource tracker first: starting it unblocks both, whatever the mask was

@@ -11,9 +11,8 @@ half the memory, and orders and factors faster (1.2M-vertex cylinder Laplacian, 
   Lᵀ`` all the same; SuperLU then reports it as before);
 - rslab refused it or could not start its threads (under ``ulimit -v`` they may not get
   their stacks: it raises a Rust panic, whose text is held back);
-- rslab was not set up in this process's main thread (:func:`start`), or this process was
-  forked from one that had: its thread pool does not survive a fork, and a factorization
-  in the child waited forever (seen with one thread too).
+- this process was forked from one that had used rslab: its thread pool does not survive a
+  fork, and a factorization in the child waited forever (seen with one thread too).
 
 Its plan of the memory a factorization needs is checked against what the process may use
 first: a Rust allocation that fails ends the process (SIGABRT), where a refused plan is a
@@ -23,7 +22,6 @@ and OpenBLAS's buffers are in) and rslab gets a matrix only with :data:`SPARE` t
 there: SuperLU, which reports a failed allocation, takes it otherwise.
 """
 import os
-import threading
 from typing import Any
 
 import numpy as np
@@ -32,7 +30,6 @@ from scipy.sparse import csr_matrix
 from ..runtime.limits import address_space_left, available_memory
 from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
-from ..runtime.threads import FORK_SERVER
 
 ENV = "SRARAP_FACTOR"
 BACKENDS = ("rslab", "superlu")
@@ -42,9 +39,8 @@ SPARE = 2
 SPARE_BYTES = 256_000_000
 #: what rslab's analysis takes per stored entry, with a margin (22 measured on a grid)
 ANALYSIS_BYTES_PER_ENTRY = 64
-#: the process in whose main thread rslab was set up (:func:`start`; 0: none). Only that
-#: process uses it: a child forked from it would hang, one never set up could crash
-_STARTED_IN = 0
+#: the process that first used rslab (0: none): a child forked from it must not
+_USED_IN = 0
 
 
 def backend() -> str:
@@ -65,9 +61,13 @@ def rslab_factor(A: csr_matrix, single: bool) -> Any:
     -------
     rslab.Ldlt or None; its ``solve_many(B)`` takes and returns (n, k) float64 arrays
     """
-    rslab = _module() if backend() == "rslab" and _STARTED_IN == os.getpid() else None
+    global _USED_IN
+    if backend() != "rslab" or _USED_IN not in (0, os.getpid()):
+        return None
+    rslab = _module()
     if rslab is None:
         return None
+    _USED_IN = os.getpid()
     dtype = "float32" if single else "float64"
     try:
         with held_c_stderr():
@@ -115,27 +115,10 @@ def _module():
     return rslab
 
 
-def start() -> None:
-    """Set rslab up in this process's main thread (elsewhere, or in a child forked from a
-    process that set it up, nothing happens, and :func:`rslab_factor` answers None there).
-
-    rslab brings its own allocator (mimalloc), which sets itself up on first use: first used
-    in a thread other than the main one, it crashed the process (SIGSEGV in
-    ``mi_thread_init`` as the multiresolution setup's background thread factored beside the
-    simplification; in the main thread's next solve after such a thread had ended). The
-    solver's import calls this, except in srarap's fork server (:data:`FORK_SERVER`): its
-    workers would be forked from a process with rslab's threads running, and hang. Those
-    workers set it up in their own main thread, as the multiresolution setup calls this
-    before its background thread starts."""
-    global _STARTED_IN
-    if _STARTED_IN or threading.current_thread() is not threading.main_thread():
-        return
-    rslab = _module() if backend() == "rslab" else None
-    if rslab is not None:
-        with held_c_stderr():
-            rslab.ldlt(csr_matrix(np.eye(2)), ordering="amd", threads=1)
-        _STARTED_IN = os.getpid()
-
-
-if os.environ.get(FORK_SERVER) != "1":
-    start()
+# Loaded here, by the thread that imports the solver (the main one): rslab brings its own
+# allocator (mimalloc), which binds its main heap to the thread that loads the library.
+# Loaded by the multiresolution setup's background thread, it crashed the process (SIGSEGV in
+# ``mi_thread_init`` beside the simplification, every run from 20,000 vertices; or in the main
+# thread's next solve after that thread had ended). Loading starts no thread: a process
+# forked after it, and before rslab's first use, uses rslab as well.
+_module()

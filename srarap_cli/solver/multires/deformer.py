@@ -20,7 +20,6 @@ from ..deformer import ACCEL_DRIVERS, Deformer, DeformResult, solve_settings
 from ..drivers.anderson import anderson_iteration
 from ..group_rotations import connected_groups, group_rotors
 from ..mesh_checks import edge_adjacency
-from ..one_triangle import start as start_rslab
 from ..quaternion import IDENTITY
 from ..settings import Settings, with_keywords
 from ..starts import STARTS
@@ -214,7 +213,6 @@ class MultiresDeformer:
         # (738k Spot: 50 s one after the other, 35 s side by side on two cores), and its
         # factorizations on beside the coarse setup and the first coarse solve (see _ready)
         built: Future[Deformer] = Future()
-        start_rslab()  # in this thread, before the background one may factor
         self._prepared: Callable[[], float] | None = background(
             partial(self._fine_setup, area, built))
         try:
