@@ -51,10 +51,10 @@ def factor(A: csr_matrix, symmetric: bool, order: Callable | None = None, approx
 
     A symmetric positive definite matrix is factored by rslab (:mod:`.one_triangle`: one
     stored triangle, half SuperLU's memory, faster) where it can be; everything else by
-    SuperLU. For SuperLU, a symmetric matrix gets a symmetric fill-reducing ordering, which roughly halves the
-    fill of SuperLU's default column ordering on mesh Laplacians, and SuperLU's symmetric
-    mode (diagonal pivots preferred): with the same fill, its triangular solves ran 1.5 to 4
-    times faster on the benchmark meshes (decimated-max Laplacian: 2.0 -> 0.5 ms).
+    SuperLU. For SuperLU, a symmetric matrix gets a symmetric fill-reducing ordering, which
+    roughly halves the fill of SuperLU's default column ordering on mesh Laplacians, and
+    SuperLU's symmetric mode (diagonal pivots preferred): with the same fill, its triangular
+    solves ran 1.5 to 4 times faster on the benchmark meshes (decimated-max Laplacian: 2.0 -> 0.5 ms).
 
     Parameters
     ----------

@@ -32,7 +32,6 @@ from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
 
 ENV = "SRARAP_FACTOR"
-BACKENDS = ("rslab", "superlu")
 #: room asked for under an address-space limit, per byte of rslab's plan: its threads' stacks
 #: and allocator arenas are mappings the plan does not count (64 MB a thread for glibc's)
 SPARE = 2
@@ -73,7 +72,7 @@ def rslab_factor(A: csr_matrix, single: bool) -> Any:
         with held_c_stderr():
             # one thread: the setup runs beside the simplification on the other core, and one
             # thread's sums come in one order (byte-identical outputs)
-            A = A.astype(np.float64)
+            A = A.astype(np.float64, copy=False)
             if not _room_for(ANALYSIS_BYTES_PER_ENTRY * A.nnz):  # its analysis allocates too
                 return None
             plan = rslab.analyze(A, path="ldlt", ordering="amd", threads=1, factor_dtype=dtype)
