@@ -19,8 +19,7 @@ def superlu(monkeypatch):
 
 
 def _use(path, monkeypatch):
-    if path != "rslab":
-        monkeypatch.setenv(one_triangle.ENV, "superlu")
+    monkeypatch.setenv(one_triangle.ENV, "rslab" if path == "rslab" else "superlu")
     if path == "nested dissection":
         monkeypatch.setattr(linalg, "LARGE", 0)
 

@@ -47,6 +47,19 @@ def test_a_matrix_that_is_not_positive_definite_is_left_to_superlu(matrix):
         assert np.abs(A @ linalg.factor(A, symmetric=True)(b) - b).max() < 1e-9
 
 
+def test_unasked_rslab_takes_large_matrices_only(monkeypatch):
+    monkeypatch.delenv(one_triangle.ENV, raising=False)
+    calls = []
+    real = linalg.rslab_factor
+    monkeypatch.setattr(linalg, "rslab_factor", lambda A, single: calls.append(A.shape[0]) or
+                        real(A, single))
+    monkeypatch.setattr(linalg, "ONE_TRIANGLE_FROM", 900)
+    for k in (29, 30):  # 841 and 900 rows
+        b = np.ones(k * k)
+        assert np.abs(_grid(k) @ linalg.factor(_grid(k), symmetric=True)(b) - b).max() < 1e-9
+    assert calls == [900]
+
+
 def test_superlu_is_used_when_the_environment_asks_for_it(monkeypatch):
     A = _grid(10)
     monkeypatch.setenv(one_triangle.ENV, "superlu")
@@ -154,6 +167,7 @@ def _twisted_tube():
 
 def test_both_factorizations_give_the_same_deformation(monkeypatch):
     V, F, ids, T = _twisted_tube()
+    monkeypatch.setenv(one_triangle.ENV, "rslab")  # at every size, this small tube's too
     ours = Deformer(V, F, ids).solve(T, tol=1e-11, max_iter=300)
     monkeypatch.setenv(one_triangle.ENV, "superlu")
     theirs = Deformer(V, F, ids).solve(T, tol=1e-11, max_iter=300)
@@ -171,7 +185,7 @@ def test_rslab_solves_are_deterministic_across_processes():
         "V, F, ids, T = _twisted_tube()\n"
         "r = Deformer(V, F, ids).solve(T, max_iter=20)\n"
         "print(hashlib.sha256(r.positions.tobytes()).hexdigest())\n")
-    env = {k: v for k, v in os.environ.items() if k != one_triangle.ENV}
+    env = {**os.environ, one_triangle.ENV: "rslab"}
     digests = {subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True,
                               text=True, check=True, env=env).stdout for _ in range(2)}
     assert len(digests) == 1 and len(next(iter(digests)).strip()) == 64
@@ -191,7 +205,7 @@ def test_a_multiresolution_deform_whose_first_factorization_runs_in_the_backgrou
         "groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
         "  tip: {box: {min: [-2, -2, 9.99], max: [2, 2, 10.01]}, rotate: "
         "{axis: [0, 1, 0], angle_deg: 40}}\n")
-    env = {k: v for k, v in os.environ.items() if k != one_triangle.ENV}
+    env = {**os.environ, one_triangle.ENV: "rslab"}  # at every size, these 25,600 vertices too
     done = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "m.obj", "h.yaml",
                            "-o", "o.obj", "--max-iter", "3", "--keep-unconverged"],
                           cwd=tmp_path, capture_output=True, text=True, timeout=300, env=env)

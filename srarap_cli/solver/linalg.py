@@ -13,7 +13,7 @@ from ..runtime.fresh_process import run_fresh
 from ..runtime.limits import is_out_of_memory
 from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
-from .one_triangle import rslab_factor
+from .one_triangle import backend, rslab_factor
 
 # Above this size SuperLU's minimum-degree ordering is what takes the time (on the 738k-vertex
 # Laplacian it had not finished after 12 minutes). METIS's nested dissection orders it in 7 s
@@ -22,6 +22,12 @@ from .one_triangle import rslab_factor
 # 184k vertices). Below, minimum degree is as good or better (46k: 0.38 s factor, 24 ms solve;
 # nested dissection 0.55 s, 23 ms).
 LARGE = 200_000
+#: rows from which a symmetric matrix goes to rslab (unless $SRARAP_FACTOR names one): below,
+#: SuperLU's solves were faster, which a small mesh's iterations are made of (4-column solve,
+#: SuperLU / rslab: 11.5k rows 2.0-3.6 / 4.4 ms, 46k 12.6-15.2 / 18-24 ms; the convergence
+#: benchmark's small meshes 10-30% slower to the stop with rslab); at 184k rslab factors
+#: 1.4-2 times faster and solves as fast (74 ms either), with half the factor memory
+ONE_TRIANGLE_FROM = 100_000
 
 
 def _warm_blas():
@@ -49,12 +55,13 @@ def factor(A: csr_matrix, symmetric: bool, order: Callable | None = None, approx
            ) -> Callable:
     """Factor a sparse square matrix; returns a callable ``solve(b)``.
 
-    A symmetric positive definite matrix is factored by rslab (:mod:`.one_triangle`: one
-    stored triangle, half SuperLU's memory, faster) where it can be; everything else by
-    SuperLU. For SuperLU, a symmetric matrix gets a symmetric fill-reducing ordering, which
-    roughly halves the fill of SuperLU's default column ordering on mesh Laplacians, and
-    SuperLU's symmetric mode (diagonal pivots preferred): with the same fill, its triangular
-    solves ran 1.5 to 4 times faster on the benchmark meshes (decimated-max Laplacian: 2.0 -> 0.5 ms).
+    A symmetric positive definite matrix of :data:`ONE_TRIANGLE_FROM` rows or more is
+    factored by rslab (:mod:`.one_triangle`: one stored triangle, half SuperLU's memory,
+    faster) where it can be; everything else by SuperLU. For SuperLU, a symmetric matrix
+    gets a symmetric fill-reducing ordering, which roughly halves the fill of SuperLU's
+    default column ordering on mesh Laplacians, and SuperLU's symmetric mode (diagonal
+    pivots preferred): with the same fill, its triangular solves ran 1.5 to 4 times faster
+    on the benchmark meshes (decimated-max Laplacian: 2.0 -> 0.5 ms).
 
     Parameters
     ----------
@@ -81,7 +88,7 @@ def factor(A: csr_matrix, symmetric: bool, order: Callable | None = None, approx
         # in the solve) brought to unit size keep meshes of any units inside it
         scale = float(abs(A).max()) or 1.0
         A = A / scale
-    ldlt = rslab_factor(A, single=approximate) if symmetric else None
+    ldlt = rslab_factor(A, single=approximate) if symmetric and _one_triangle(A) else None
     if ldlt is not None:
         return _rslab_solver(ldlt, scale, approximate)
     if symmetric and approximate:
@@ -148,6 +155,12 @@ def _solver(lu, dtype, scale=1.0):
         return np.multiply(X, size / scale, dtype=float)
 
     return solve
+
+
+def _one_triangle(A):
+    """Whether rslab may take the symmetric ``A``: asked for, or large enough unasked."""
+    asked = backend()
+    return asked == "rslab" or asked == "auto" and A.shape[0] >= ONE_TRIANGLE_FROM
 
 
 def _rslab_solver(ldlt, scale, single):

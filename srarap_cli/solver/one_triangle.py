@@ -6,7 +6,9 @@ half the memory, and orders and factors faster (1.2M-vertex cylinder Laplacian, 
 2.7 GB). :func:`rslab_factor` answers None wherever it cannot be relied on, and the caller
 (:func:`..linalg.factor`) then uses SuperLU:
 
-- rslab is not installed, or ``$SRARAP_FACTOR=superlu`` asks for SuperLU;
+- rslab is not installed, or ``$SRARAP_FACTOR=superlu`` asks for SuperLU (``rslab`` asks
+  for rslab at every size; unset, :func:`..linalg.factor` uses it from
+  :data:`..linalg.ONE_TRIANGLE_FROM` rows);
 - the matrix is not positive definite (a singular or indefinite matrix factors in ``L D
   Lᵀ`` all the same; SuperLU then reports it as before);
 - rslab refused it or could not start its threads (under ``ulimit -v`` they may not get
@@ -43,8 +45,10 @@ _USED_IN = 0
 
 
 def backend() -> str:
-    """The factorization ``$SRARAP_FACTOR`` asks for (``rslab`` unless it says ``superlu``)."""
-    return "superlu" if os.environ.get(ENV, "").strip().lower() == "superlu" else "rslab"
+    """The factorization ``$SRARAP_FACTOR`` asks for: ``rslab`` or ``superlu`` for every
+    matrix, else ``auto`` (:func:`..linalg.factor` picks by size)."""
+    asked = os.environ.get(ENV, "").strip().lower()
+    return asked if asked in ("rslab", "superlu") else "auto"
 
 
 def rslab_factor(A: csr_matrix, single: bool) -> Any:
@@ -61,7 +65,7 @@ def rslab_factor(A: csr_matrix, single: bool) -> Any:
     rslab.Ldlt or None; its ``solve_many(B)`` takes and returns (n, k) float64 arrays
     """
     global _USED_IN
-    if backend() != "rslab" or _USED_IN not in (0, os.getpid()):
+    if backend() == "superlu" or _USED_IN not in (0, os.getpid()):
         return None
     rslab = _module()
     if rslab is None:
