@@ -68,6 +68,18 @@ def test_superlu_is_used_when_the_environment_asks_for_it(monkeypatch):
     assert np.abs(A @ linalg.factor(A, symmetric=True)(b) - b).max() < 1e-10
 
 
+def test_an_unknown_factorization_asked_for_is_one_line_and_invalid_input(tmp_path):
+    env = {**os.environ, one_triangle.ENV: "supperlu"}
+    done = subprocess.run([sys.executable, "-m", "srarap_cli", "deform",
+                           os.path.join(ROOT, "sample_meshes", "bar.obj"),
+                           os.path.join(ROOT, "configs", "bar-twist.yaml"), "-o", "o.obj"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120, env=env)
+    assert done.returncode == 4, done.stderr
+    assert done.stderr == ("srarap: error: SRARAP_FACTOR='supperlu': expected rslab, superlu "
+                           "or auto\n")
+    assert not (tmp_path / "o.obj").exists()
+
+
 def test_a_factorization_that_would_not_fit_is_out_of_memory(monkeypatch):
     monkeypatch.setenv("SRARAP_MEMORY_LIMIT", "1000")
     with pytest.raises(MemoryError, match="needs"):

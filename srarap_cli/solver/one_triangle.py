@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 from scipy.sparse import csr_matrix
 
+from ..runtime.errors import InputError
 from ..runtime.limits import address_space_left, available_memory
 from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
@@ -46,9 +47,11 @@ _USED_IN = 0
 
 def backend() -> str:
     """The factorization ``$SRARAP_FACTOR`` asks for: ``rslab`` or ``superlu`` for every
-    matrix, else ``auto`` (:func:`..linalg.factor` picks by size)."""
-    asked = os.environ.get(ENV, "").strip().lower()
-    return asked if asked in ("rslab", "superlu") else "auto"
+    matrix, ``auto`` (or unset: :func:`..linalg.factor` picks by size)."""
+    asked = os.environ.get(ENV, "").strip().lower() or "auto"
+    if asked not in ("auto", "rslab", "superlu"):
+        raise InputError(f"{ENV}={os.environ[ENV]!r}: expected rslab, superlu or auto")
+    return asked
 
 
 def rslab_factor(A: csr_matrix, single: bool) -> Any:
