@@ -105,7 +105,7 @@ def main():
     for size in args.sizes:
         _, r, s = run(p, opts, size, args.tol, args.max_iter)
         dist = np.linalg.norm(r.positions - ref.positions, axis=1) / diag
-        rows.append({"coarse": r.coarse["vertices"], "seconds": s, "iterations": r.iterations,
+        rows.append({"coarse": r.multires.coarse_vertices, "seconds": s, "iterations": r.iterations,
                      "energy": r.energy, "rel_energy": r.energy / e_ref,
                      "rel_energy_refit": refit_energy(direct, r.positions, r.rotors) / e_ref,
                      "max_dist": float(dist.max()), "mean_dist": float(dist.mean())})

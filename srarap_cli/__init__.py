@@ -14,7 +14,7 @@ do not load the numerical stack.
 """
 import importlib
 
-_WHERE = {"Constraints": "io.handles", "DeformResult": "solver.deformer",
+_WHERE = {"Constraints": "io.handles", "DeformResult": "solver.result",
           "Deformer": "solver.deformer", "Mesh": "io.mesh", "Settings": "solver.settings",
           "Solver": "solver.interface", "StopReason": "solver.stop", "deform": "tasks.api",
           "deform_mesh": "tasks.pipeline", "load_handles": "io.handles", "read_mesh": "io.mesh",

@@ -7,8 +7,8 @@ from .io.mesh import Mesh as Mesh
 from .io.mesh import read_mesh as read_mesh
 from .io.mesh import write_mesh as write_mesh
 from .solver.deformer import Deformer as Deformer
-from .solver.deformer import DeformResult as DeformResult
 from .solver.interface import Solver as Solver
+from .solver.result import DeformResult as DeformResult
 from .solver.settings import Settings as Settings
 from .solver.stop import StopReason as StopReason
 from .tasks.api import deform as deform

@@ -107,10 +107,34 @@ def test_a_result_and_a_solver_print_as_one_short_line():
     md = make_deformer(spot.vertices, spot.triangles()[0], nod.ids,
                        settings=resolve({"multires": 2000}))
     mr = md.solve(nod.targets)
-    for thing in (r, d, md, mr):
+    for thing in (r, d, md, mr, mr.multires):
         text = repr(thing)
         assert "\n" not in text and len(text) < 200, text
-    assert repr(mr).startswith("MultiresResult(converged, ") and "coarse)" in repr(mr)
+    assert repr(mr).startswith("DeformResult(converged, ") and "coarse)" in repr(mr)
+    assert repr(mr.multires).startswith("MultiresPart(refine, ")
+
+
+def test_one_result_type_with_an_optional_multiresolution_part():
+    """Both solvers return a DeformResult: the full-resolution one without a multires part,
+    the multiresolution one with its coarse solve's part (refine and transfer)."""
+    from helpers import ROOT
+
+    import srarap_cli
+    from srarap_cli.solver.result import MultiresPart
+
+    spot = srarap_cli.read_mesh(f"{ROOT}/sample_meshes/spot.obj")
+    plain = srarap_cli.deform(spot, f"{ROOT}/configs/spot-nod.yaml", multires="off")
+    refined = srarap_cli.deform(spot, f"{ROOT}/configs/spot-nod.yaml", multires=1500)
+    moved = srarap_cli.deform(spot, f"{ROOT}/configs/spot-nod.yaml", multires=1500,
+                              multires_mode="transfer")
+    assert type(plain) is type(refined) is type(moved) is srarap_cli.DeformResult
+    assert plain.multires is None and plain.coarse_iterations == 0 and not plain.approximate
+    for r in (refined, moved):
+        assert isinstance(r.multires, MultiresPart) and r.multires.coarse_vertices <= 1500
+        assert r.coarse_iterations == r.multires.iterations > 0 and r.multires.converged
+    assert not refined.approximate and moved.approximate and moved.complete
+    assert refined.energies() == {k: refined.log[-1][k] for k in ("membrane", "bending", "total")}
+    assert moved.energies() == moved.multires.full_energy
 
 
 @pytest.mark.slow

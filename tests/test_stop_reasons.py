@@ -52,9 +52,9 @@ def test_the_papers_transfer_is_complete_when_its_coarse_solve_is(bent):
     d = MultiresDeformer(V, F, ids, size=60, multires_mode="transfer")
     r = d.solve(T)
     assert r.stop_reason is StopReason.TRANSFER and r.approximate
-    assert r.coarse_stop_reason is StopReason.CONVERGED and r.complete
+    assert r.multires.stop_reason is StopReason.CONVERGED and r.complete
     short = d.solve(T, max_iter=1)
-    assert short.coarse_stop_reason is StopReason.ITERATION_LIMIT and not short.complete
+    assert short.multires.stop_reason is StopReason.ITERATION_LIMIT and not short.complete
 
 
 def test_both_solvers_satisfy_the_one_interface(bent):

@@ -18,7 +18,7 @@ from ..runtime.commit import COMMITTED
 from ..runtime.errors import OutputError
 from ..runtime.failures import classify
 from ..runtime.signals import Terminated
-from ..solver.deformer import DeformResult
+from ..solver.result import DeformResult
 
 
 def fail(code: int, message: str) -> NoReturn:

@@ -93,10 +93,11 @@ def _summary(result, opts, out):
               f"{e['bending']:.6g})")
     reason = result.stop_reason
     if result.approximate:
+        part = result.multires
         state = (f"approximate (multires transfer: coarse solve "
-                 f"{'converged' if result.coarse_converged else 'NOT converged'} in "
-                 f"{result.coarse_iterations} iterations, none at full resolution)")
-        energy = f"full-resolution {energy}, {result.start_energy['total']:.6g} at the start"
+                 f"{'converged' if part.converged else 'NOT converged'} in "
+                 f"{part.iterations} iterations, none at full resolution)")
+        energy = f"full-resolution {energy}, {part.start_energy['total']:.6g} at the start"
     elif reason is StopReason.CONVERGED:
         state = f"converged in {result.iterations} full-resolution iterations{coarse}"
     elif reason is StopReason.ITERATIONS_RUN:

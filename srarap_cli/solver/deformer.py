@@ -7,7 +7,6 @@ when to stop. This class holds what they share: weights, rest edges, the factore
 matrix and the local step.
 """
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -25,6 +24,7 @@ from .local_step import METHODS
 from .mesh_checks import geometry_problem
 from .operators import cell_graph
 from .rest_edges import RestEdges
+from .result import DeformResult
 from .settings import Settings, with_keywords
 from .starts import STARTS, WARM_STARTS
 from .step import LocalGlobalStep
@@ -32,100 +32,6 @@ from .stop import StopReason
 
 # the ``accel`` setting names a driver
 ACCEL_DRIVERS = {"anderson": "anderson", "none": "plain"}
-
-
-@dataclass
-class DeformResult:
-    """Outcome of :meth:`Deformer.solve`.
-
-    Attributes
-    ----------
-    positions : (n, 3) float array
-    rotors : (n, 4) float array, unit quaternions (w, x, y, z) of the vertex cells
-    log : list of dict, one per iteration (0 is the start), keys ``solve_log.LOG_FIELDS``
-    stop_reason : StopReason, why the solve stopped (see :mod:`srarap_cli.solver.stop`)
-    iterations : int, local/global iterations run at full resolution
-    stop_detail : str, for a solve stopped unconverged: which stopping test still failed,
-        with its numbers
-    converged : bool (property), the stopping test passed at full resolution
-    complete : bool (property), the solve ended as asked: converged, or ``tol`` 0 ran the
-        iterations asked; for the multiresolution transfer, its coarse solve did
-    coarse_iterations : int, iterations on coarse meshes (multiresolution; 0 here)
-    coarse_log : bool (class attribute), the log follows another mesh than the result
-    approximate : bool (property), the result is the paper's transfer of a coarse solve, not
-        iterated at full resolution
-    """
-
-    coarse_log = False
-    coarse_iterations = 0
-    positions: np.ndarray
-    rotors: np.ndarray
-    log: list[dict]
-    stop_reason: StopReason
-    iterations: int
-    stop_detail: str = ""
-    #: (f, 3) triangles of the mesh, when the result came from ``srarap_cli.deform`` on a mesh
-    faces: np.ndarray | None = None
-    #: what the input or the solve found worth a warning (mesh problems, weights)
-    warnings: list[str] = field(default_factory=list)
-
-    def to_arrays(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(V, F)``: the deformed positions (n, 3) and the triangles (f, 3)."""
-        if self.faces is None:
-            raise ValueError("this result carries no faces: pair positions with your F")
-        return self.positions, self.faces
-
-    def to_trimesh(self) -> Any:
-        """A ``trimesh.Trimesh`` of the deformed shape (needs trimesh installed)."""
-        import trimesh
-
-        V, F = self.to_arrays()
-        return trimesh.Trimesh(vertices=V, faces=F, process=False)
-
-    def to_meshio(self) -> Any:
-        """A ``meshio.Mesh`` of the deformed shape (needs meshio installed)."""
-        import meshio
-
-        V, F = self.to_arrays()
-        return meshio.Mesh(V, [("triangle", F)])
-
-    @property
-    def approximate(self) -> bool:
-        return False
-
-    @property
-    def converged(self) -> bool:
-        return self.stop_reason is StopReason.CONVERGED
-
-    @property
-    def complete(self) -> bool:
-        return self.stop_reason.complete
-
-    def energies(self) -> dict[str, float]:
-        """``membrane``, ``bending`` and ``total`` energy of the returned shape."""
-        return {k: self.log[-1][k] for k in ("membrane", "bending", "total")}
-
-    @property
-    def energy(self) -> float:
-        return self.energies()["total"]
-
-    @property
-    def seconds(self) -> float:
-        """Wall time of the solve."""
-        return self.log[-1]["seconds"]
-
-    def report_lines(self) -> list[str]:
-        """Extra lines a command prints about how the result was obtained (none here)."""
-        return []
-
-    def __repr__(self) -> str:
-        """One line: how the solve ended, its size and energy (the arrays and the log are
-        attributes, not printed: a notebook cell ending in a result stays readable)."""
-        coarse = f" (+ {self.coarse_iterations} coarse)" if self.coarse_iterations else ""
-        state = "converged" if self.converged else str(self.stop_reason)
-        return (f"{type(self).__name__}({state}, {self.iterations} iterations{coarse}, "
-                f"energy {self.energy:.6g}, {len(self.positions)} vertices, "
-                f"{len(self.warnings)} warnings)")
 
 
 class Deformer:

@@ -12,7 +12,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .deformer import DeformResult
+from .result import DeformResult
 from .settings import Settings
 
 

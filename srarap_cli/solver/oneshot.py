@@ -5,10 +5,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .deformer import Deformer, DeformResult
+from .deformer import Deformer
 from .interface import Solver
 from .multires.deformer import MultiresDeformer
 from .multires.size import coarse_size
+from .result import DeformResult
 from .settings import Settings, with_keywords
 
 

@@ -17,7 +17,7 @@ from ..runtime.commit import commit_files
 from ..runtime.encoding import utf8
 from ..runtime.errors import InputError
 from ..runtime.limits import check_solve
-from ..solver.deformer import DeformResult
+from ..solver.result import DeformResult
 from ..solver.settings import resolve
 from .animation import FRAME_FIELDS, Animator, FrameState, fingerprint, unreached_keys
 from .frame_files import MAX_FRAMES, check_pattern, frame_count, frames_on_disk, remove_stale, suffix

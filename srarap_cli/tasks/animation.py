@@ -24,8 +24,8 @@ from ..io.handles import Constraints
 from ..io.input_files import read_input_bytes
 from ..io.mesh.mesh import Mesh
 from ..runtime.errors import InputError, excerpt
-from ..solver.deformer import DeformResult
 from ..solver.quaternion import align_hemisphere, multiply, normalize
+from ..solver.result import DeformResult
 from ..solver.settings import Settings
 from .pipeline import command_solver, problem, scatter
 

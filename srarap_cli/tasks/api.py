@@ -8,8 +8,8 @@ import numpy as np
 from ..io.handles import as_constraints
 from ..io.mesh.mesh import Mesh
 from ..solver.api_checks import mesh_like
-from ..solver.deformer import DeformResult
 from ..solver.oneshot import deform as deform_arrays
+from ..solver.result import DeformResult
 from ..solver.settings import STAGES, Settings, keywords, resolve
 from .pipeline import deform_mesh
 

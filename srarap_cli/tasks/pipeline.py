@@ -9,13 +9,13 @@ from ..io.handles import Constraints
 from ..io.mesh import Mesh
 from ..runtime.allocator import keep_freed_memory
 from ..runtime.errors import InputError
-from ..solver.deformer import DeformResult
 from ..solver.interface import Solver
 from ..solver.mesh_checks import geometry_problem, mesh_warnings, solvable_faces
 from ..solver.oneshot import make_deformer
 from ..solver.operators import mesh_area
 from ..solver.quaternion import IDENTITY
 from ..solver.region import restrict
+from ..solver.result import DeformResult
 from ..solver.settings import STAGES, Settings, resolve, with_keywords
 from .rigid_parts import rigid_part_warnings
 
@@ -145,7 +145,7 @@ def deform_mesh(mesh: Mesh, constraints: Constraints, settings: Settings | None 
     Returns
     -------
     deformed : Mesh, same vertices and faces, new positions and normals
-    result : DeformResult (or MultiresResult), positions/rotors of the whole mesh
+    result : DeformResult, positions/rotors of the whole mesh
     warnings : list of str
     """
     settings = with_keywords(settings or resolve(constraints.solver), options, STAGES,

@@ -7,11 +7,11 @@ simplifier or the solver.
 import importlib
 from typing import Any
 
-_WHERE = {"MultiresDeformer": "deformer", "MultiresResult": "deformer",
+_WHERE = {"MultiresDeformer": "deformer",
           "CoarseMesh": "simplify", "simplify_to_subset": "simplify",
           "coarse_size": "size", "parse_size": "size"}
 
-__all__ = ["CoarseMesh", "MultiresDeformer", "MultiresResult", "coarse_size", "parse_size",
+__all__ = ["CoarseMesh", "MultiresDeformer", "coarse_size", "parse_size",
            "simplify_to_subset"]
 
 

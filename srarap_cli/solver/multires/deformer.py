@@ -5,7 +5,6 @@ import contextlib
 import time
 from collections.abc import Callable
 from concurrent.futures import Future
-from dataclasses import dataclass, field
 from functools import partial
 from typing import Any
 
@@ -16,11 +15,12 @@ from ...runtime import memory
 from ...runtime.errors import NumericalError
 from ...runtime.threads import background, single_threaded
 from .. import api_checks
-from ..deformer import ACCEL_DRIVERS, Deformer, DeformResult, solve_settings
+from ..deformer import ACCEL_DRIVERS, Deformer, solve_settings
 from ..drivers.anderson import anderson_iteration
 from ..group_rotations import connected_groups, group_rotors
 from ..mesh_checks import edge_adjacency
 from ..quaternion import IDENTITY
+from ..result import DeformResult, MultiresPart
 from ..settings import Settings, with_keywords
 from ..starts import STARTS
 from ..stop import StopReason
@@ -31,83 +31,11 @@ from .prolong import nearest_coarse, prolong
 from .size import coarse_size
 from .transfer import orient_group_rotors, spread_rotors
 
-STAGE_NAMES = {"simplify": "simplify", "coarse_precompute": "coarse setup",
-               "factor": "fine setup", "coarse_solve": "coarse solve", "transfer": "transfer",
-               "fine_solve": "fine solve", "fine_start": "full-resolution start",
-               "fine_iterations": "full-resolution iterations"}
 #: full-resolution iterations of a warm solve before the coarse-grid corrections join
 WARM_UNCORRECTED = 5
 #: a coarse mesh keeping more than this fraction of the vertices gains nothing over a
 #: full-resolution solve
 NO_GAIN = 0.5
-
-
-@dataclass(repr=False)  # DeformResult's one line, not every array and log row
-class MultiresResult(DeformResult):
-    """A :class:`DeformResult` of a multiresolution solve. Its ``log`` holds the coarse
-    iterations (``step`` prefixed ``coarse-``), then, in ``refine`` mode, the full-resolution
-    ones. Besides:
-
-    Attributes
-    ----------
-    coarse_log : bool, the log ends with coarse iterations (``transfer`` mode)
-    full_energy : dict, ``membrane``, ``bending``, ``total`` of the returned full-resolution
-        positions and rotors
-    stages : dict, seconds per stage (see STAGE_NAMES); the simplification and the
-        full-resolution setup run side by side, so the stages add up to more than the wall time
-    coarse : dict, ``vertices`` (coarse count), ``of`` (full count), ``cache_hit``
-    coarse_iterations : int, iterations of the coarse solve (and the coarser ones inside it)
-    coarse_stop_reason : StopReason or None, why the coarse solve stopped (None: a warm
-        solve, which has none)
-    coarse_converged : bool (property), the coarse solve passed its stopping test
-    start_energy : dict, transfer mode: the full-resolution energies of the rest shape with
-        the constrained vertices at their targets (what the approximation is judged against)
-    wall : float, wall seconds of the solve (setup excluded)
-    memory : dict, peak resident bytes per stage (``setup``, then the solve's stages; None
-        where the platform cannot tell, see :mod:`srarap_cli.runtime.memory`)
-    """
-
-    coarse_log: bool = True
-    full_energy: dict = field(default_factory=dict)
-    stages: dict = field(default_factory=dict)
-    coarse: dict = field(default_factory=dict)
-    coarse_iterations: int = 0
-    coarse_stop_reason: StopReason | None = None
-    start_energy: dict = field(default_factory=dict)
-    wall: float = 0.0
-    memory: dict = field(default_factory=dict)
-
-    def energies(self) -> dict[str, float]:
-        return dict(self.full_energy)
-
-    @property
-    def approximate(self) -> bool:
-        return self.coarse_log
-
-    @property
-    def coarse_converged(self) -> bool:
-        return self.coarse_stop_reason is StopReason.CONVERGED
-
-    @property
-    def complete(self) -> bool:
-        """As :attr:`DeformResult.complete`; the paper's transfer is complete when its coarse
-        solve is (the full-resolution shape is never iterated there)."""
-        if self.approximate:
-            return self.coarse_stop_reason is not None and self.coarse_stop_reason.complete
-        return self.stop_reason.complete
-
-    @property
-    def seconds(self) -> float:
-        return self.wall
-
-    def report_lines(self) -> list[str]:
-        """``srarap: multires: 5002 of 737986 vertices; simplify 1.20 s, ...``"""
-        info = self.coarse
-        cached = " (coarse mesh from cache)" if info["cache_hit"] else ""
-        times = ", ".join(f"{STAGE_NAMES.get(k, k)} {v:.2f} s" for k, v in self.stages.items())
-        lines = [f"srarap: multires: {info['vertices']} of {info['of']} vertices{cached}; {times}"]
-        peaks = memory.gigabytes({STAGE_NAMES.get(k, k): v for k, v in self.memory.items()})
-        return lines + ([f"srarap: multires: peak memory per stage: {peaks}"] if peaks else [])
 
 
 class _Delayed:
@@ -307,11 +235,8 @@ class MultiresDeformer:
             fine.prepare()
         return time.perf_counter() - mark
 
-    @property
-    def info(self) -> dict[str, Any]:
-        """``vertices`` (coarse count), ``of`` (full count), ``cache_hit``."""
-        return {"vertices": int(self.coarse.vertices.size), "of": len(self.V),
-                "cache_hit": self.cache_hit}
+    def _part(self, **fields: Any) -> MultiresPart:
+        return MultiresPart(int(self.coarse.vertices.size), self.cache_hit, **fields)
 
     def _build_coarse(self, cache):
         start = time.perf_counter()
@@ -346,9 +271,10 @@ class MultiresDeformer:
     def solve(self, targets: ArrayLike, *, initial: tuple[np.ndarray, np.ndarray] | None = None,
               callback: Callable[[dict], None] | None = None,
               settings: Settings | None = None, start: str | None = None,
-              **options: Any) -> "MultiresResult":
+              **options: Any) -> DeformResult:
         """Deform toward ``targets``; see :meth:`Deformer.solve` (``max_iter`` and
-        ``time_limit`` hold for each level). Returns a :class:`MultiresResult`."""
+        ``time_limit`` hold for each level). Returns a
+        :class:`~srarap_cli.solver.result.DeformResult` with its ``multires`` part."""
         begin = time.perf_counter()
         s = solve_settings(self.settings, settings, options, "solve")
         targets = api_checks.targets(targets, len(self.constrained))
@@ -385,12 +311,11 @@ class MultiresDeformer:
         offset, elapsed = len(log), mark - begin
         log += [dict(row, iteration=row["iteration"] + offset, seconds=row["seconds"] + elapsed)
                 for row in fine.log]
-        return MultiresResult(fine.positions, fine.rotors, log, fine.stop_reason,
-                              fine.iterations, fine.stop_detail, coarse_log=False,
-                              full_energy=fine.energies(), stages=stages, coarse=self.info,
-                              coarse_iterations=_all_iterations(coarse),
-                              coarse_stop_reason=coarse.stop_reason,
-                              wall=time.perf_counter() - begin, memory=peaks)
+        part = self._part(iterations=_all_iterations(coarse), stop_reason=coarse.stop_reason,
+                          full_energy=fine.energies(), stages=stages, memory=peaks,
+                          wall=time.perf_counter() - begin)
+        return DeformResult(fine.positions, fine.rotors, log, fine.stop_reason, fine.iterations,
+                            fine.stop_detail, multires=part)
 
     def _warm(self, targets, initial, callback, settings, start, begin):
         """A warm start (an animation's next frame, a nearby pose) goes straight to the
@@ -411,10 +336,10 @@ class MultiresDeformer:
         fine = self.fine.solve(targets, initial=initial, callback=callback, settings=settings,
                                start=start, driver=driver)
         stages = {"fine_iterations": time.perf_counter() - begin}
-        return MultiresResult(fine.positions, fine.rotors, list(fine.log), fine.stop_reason,
-                              fine.iterations, fine.stop_detail, coarse_log=False,
-                              full_energy=fine.energies(), stages=stages, coarse=self.info,
-                              wall=time.perf_counter() - begin)
+        part = self._part(full_energy=fine.energies(), stages=stages,
+                          wall=time.perf_counter() - begin)
+        return DeformResult(fine.positions, fine.rotors, list(fine.log), fine.stop_reason,
+                            fine.iterations, fine.stop_detail, multires=part)
 
     def coarse_correction(self, targets: np.ndarray, tol: float | None = None) -> Any:
         """The :class:`~.correction.CoarseCorrection` of the full-resolution iterates for
@@ -469,12 +394,11 @@ class MultiresDeformer:
         rest = self.V.copy()
         rest[self.constrained] = targets
         start = self.fine.energy(rest, np.tile(IDENTITY, (len(self.V), 1)))
-        return MultiresResult(P, R, log, StopReason.TRANSFER, 0, full_energy=energy,
-                              stages=stages, coarse=self.info,
-                              coarse_iterations=_all_iterations(coarse),
-                              coarse_stop_reason=coarse.stop_reason, start_energy=start,
-                              wall=time.perf_counter() - begin,
-                              memory=dict(peaks, transfer=memory.stop(peak)))
+        part = self._part(iterations=_all_iterations(coarse), stop_reason=coarse.stop_reason,
+                          transfer=True, full_energy=energy, start_energy=start, stages=stages,
+                          memory=dict(peaks, transfer=memory.stop(peak)),
+                          wall=time.perf_counter() - begin)
+        return DeformResult(P, R, log, StopReason.TRANSFER, 0, multires=part)
 
     def _known_rotors(self, targets, coarse_rotors):
         out = np.tile(IDENTITY, (self._known.size, 1))
