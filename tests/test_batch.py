@@ -108,7 +108,7 @@ def test_scheduler_local_starts_single_threaded_workers_without_dasks_trim_setti
 
     import dask
 
-    from srarap_cli.tasks.batch_dask import run_on_dask
+    from srarap_cli.tasks.batch.on_dask import run_on_dask
 
     jobs = [{"name": "twist", "mesh": BAR, "handles": TWIST, "output": "twist.obj"}]
     path = manifest(tmp_path, jobs)

@@ -24,8 +24,9 @@ from srarap_cli.runtime.errors import (
     OutputError,
     SingularSystemError,
 )
-from srarap_cli.tasks import batch, job
-from srarap_cli.tasks.batch_rows import interrupted_row
+from srarap_cli.tasks import job
+from srarap_cli.tasks.batch import run as batch
+from srarap_cli.tasks.batch.rows import interrupted_row
 from srarap_cli.tasks.job_status import JobStatus
 
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")

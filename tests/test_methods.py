@@ -100,3 +100,19 @@ def test_colour_classes_never_put_neighbours_together():
 def test_unknown_method_is_rejected():
     with pytest.raises(ValueError, match="method must be one of"):
         Deformer(V, F, IDS, method="fast")
+
+
+@pytest.mark.parametrize("method", sorted(METHODS))
+def test_the_settings_a_method_owns_reach_its_constructor(method):
+    """The settings table's ``method`` column is the only link between a setting and its local
+    step: each one it names is a keyword of that step's constructor, and no other method
+    gets it."""
+    import inspect
+
+    from srarap_cli.solver.settings import SETTINGS, resolve
+
+    owned = {s.name for s in SETTINGS if s.method == method}
+    options = resolve({"method": method}).method_options()
+    assert set(options) == owned
+    assert owned <= set(inspect.signature(METHODS[method]).parameters)
+    assert any(s.method for s in SETTINGS)  # the column is used (sweeps: sr-relax)

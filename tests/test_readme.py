@@ -112,7 +112,7 @@ def test_the_handle_file_guide_names_every_key_the_schema_knows():
 
 
 def test_the_guides_manifest_example_is_a_valid_manifest(tmp_path):
-    from srarap_cli.tasks.manifest import load_manifest
+    from srarap_cli.tasks.batch.manifest import load_manifest
     guide = Path(ROOT, "docs", "guides", "workflows.md").read_text(encoding="utf-8")
     block = re.search(r"```yaml\n(.*?)```", guide, re.DOTALL).group(1)
     (tmp_path / "configs").mkdir()  # the samples' layout, as `srarap samples` writes it

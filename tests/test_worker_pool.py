@@ -8,7 +8,7 @@ import pytest
 import yaml
 from helpers import ROOT
 
-from srarap_cli.tasks.worker_pool import death_note, run_in_processes
+from srarap_cli.tasks.batch.worker_pool import death_note, run_in_processes
 
 
 @pytest.mark.slow
@@ -41,7 +41,7 @@ def test_death_notes_name_the_signal_or_the_code():
 # (forked from the batch or from a fork server)
 KILL_HUGE = """
 import os, signal
-from srarap_cli.tasks import batch
+from srarap_cli.tasks.batch import run as batch
 real = batch.run_job
 def run_job(job, *args, **kwargs):
     if job["name"] == "huge":

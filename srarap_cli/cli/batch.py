@@ -12,12 +12,12 @@ from ..runtime.commit import commit_files
 from ..runtime.encoding import utf8
 from ..runtime.errors import OutputError
 from ..runtime.signals import Terminated, block
-from ..tasks.batch import run_batch
-from ..tasks.batch_rows import BatchInterrupted
+from ..tasks.batch.manifest import check_outputs, load_manifest
+from ..tasks.batch.report import junit_xml, report_html
+from ..tasks.batch.rows import BatchInterrupted
+from ..tasks.batch.run import run_batch
 from ..tasks.job_status import SUMMARY_FIELDS, WARNING_JOIN, JobStatus
-from ..tasks.manifest import check_outputs, load_manifest
 from ..tasks.preflight import check_output_path
-from ..tasks.report import junit_xml, report_html
 from .common import guarded, say
 
 #: a Dask scheduler address: protocol://host:port, or host:port

@@ -7,11 +7,11 @@ from ..io.mesh.formats import MeshFormat
 from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..runtime.encoding import utf8
+from ..tasks.batch.job_pictures import compare_pictures
+from ..tasks.batch.report import junit_xml, report_html
 from ..tasks.compare import beyond, compare_meshes
-from ..tasks.job_pictures import compare_pictures
 from ..tasks.job_status import JobResult, JobStatus
 from ..tasks.preflight import check_output_path, read_any_mesh, refuse_overwrite
-from ..tasks.report import junit_xml, report_html
 from .common import FiniteFloat, guarded, input_format_option, say
 
 

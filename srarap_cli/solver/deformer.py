@@ -146,10 +146,9 @@ class Deformer:
         if self._poisson is None:
             self._poisson = PoissonSolver(self.graph, self._mask)
             s = self.settings
-            extra = {"sweeps": s.sweeps} if s.method == "sr-relax" else {}
             self._local_step = METHODS[s.method](self.edges, self._rotor_mask(),
                                                  s.alpha * self.area, s.feedback,
-                                                 **extra)
+                                                 **s.method_options())
         return self
 
     def _rotor_mask(self):

@@ -195,6 +195,11 @@ class Settings:
         """A copy with ``changes`` (validated; None keeps the current value)."""
         return with_keywords(self, changes, STAGES, "Settings.replace")
 
+    def method_options(self) -> dict[str, Any]:
+        """The settings that belong to this local step (the table's ``method``), by name:
+        what its constructor takes besides the shared arguments."""
+        return {s.name: getattr(self, s.name) for s in SETTINGS if s.method == self.method}
+
     def fixed_at_setup(self, other: "Settings") -> list[str]:
         """The setup and build settings in which ``other`` differs from this one: what a
         solver built with this one cannot change per solve."""

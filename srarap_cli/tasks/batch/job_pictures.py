@@ -6,12 +6,12 @@ from typing import Any
 
 import numpy as np
 
-from ..io.handles import Constraints
-from ..io.mesh.mesh import Mesh
-from .info import up_axis
-from .log_axis import decades_axis
-from .preview import UP
-from .render import face_colors, render_png
+from ...io.handles import Constraints
+from ...io.mesh.mesh import Mesh
+from ..info import up_axis
+from ..log_axis import decades_axis
+from ..preview import UP
+from ..render import face_colors, render_png
 
 #: each picture's size in pixels: a report of 100 jobs stays a few megabytes
 THUMBNAIL = (240, 200)

@@ -5,12 +5,12 @@ import logging
 import os
 from collections.abc import Callable
 
-from ..runtime.environment import environ_changed
-from ..runtime.errors import InputError
-from ..runtime.signals import Terminated
-from ..runtime.threads import worker_processes
-from .batch_rows import BatchInterrupted, Job, interrupted_row, unfinished_row
-from .job_status import JobResult
+from ...runtime.environment import environ_changed
+from ...runtime.errors import InputError
+from ...runtime.signals import Terminated
+from ...runtime.threads import worker_processes
+from ..job_status import JobResult
+from .rows import BatchInterrupted, Job, interrupted_row, unfinished_row
 from .worker_pool import WORKER_START
 
 #: what srarap's own Dask workers get instead of Dask's defaults: one BLAS thread, and glibc's

@@ -9,8 +9,8 @@ anywhere else would change that process's signals: only a fork server imports it
 """
 import signal
 
-from ..runtime.signals import SIGNALS
-from . import batch  # noqa: F401  (imported here so that workers start with it)
+from ...runtime.signals import SIGNALS
+from . import run  # noqa: F401  (imported here so that workers start with it)
 
 signal.signal(signal.SIGINT, signal.SIG_IGN)
 signal.signal(signal.SIGTERM, signal.SIG_DFL)

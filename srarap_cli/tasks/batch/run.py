@@ -20,14 +20,14 @@ import os
 import time
 from typing import Any
 
-from ..io.handles import load_handles
-from ..io.mesh import read_mesh
-from ..runtime.signals import Terminated
-from .batch_dask import run_on_dask
-from .batch_rows import BatchInterrupted, Job, deform_job, interrupted_row, lost_row
-from .job import JobResult, run_job_safely
+from ...io.handles import load_handles
+from ...io.mesh import read_mesh
+from ...runtime.signals import Terminated
+from ..job import JobResult, run_job_safely
 from .job_pictures import difference_picture, energy_picture, shape_picture
+from .on_dask import run_on_dask
 from .report import encode_png
+from .rows import BatchInterrupted, Job, deform_job, interrupted_row, lost_row
 from .worker_pool import PoolStopped, run_in_processes
 
 

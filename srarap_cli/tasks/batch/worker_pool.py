@@ -17,12 +17,12 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
-from ..runtime.signals import SIGNALS, Terminated, deferred
-from ..runtime.threads import worker_processes
+from ...runtime.signals import SIGNALS, Terminated, deferred
+from ...runtime.threads import worker_processes
 
 #: what the server that forks worker processes imports first: the jobs' code and the workers'
 #: signal dispositions
-WORKER_START = "srarap_cli.tasks.worker_start"
+WORKER_START = "srarap_cli.tasks.batch.worker_start"
 #: seconds the workers get to stop after SIGTERM before they are killed
 STOP_GRACE = 2.0
 

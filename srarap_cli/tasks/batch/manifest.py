@@ -3,13 +3,13 @@ output lands on what a job reads (see :mod:`.batch` for the format)."""
 import math
 import os
 
-from ..io.documents import load_document
-from ..io.handles import referenced_files
-from ..io.mesh.formats import extensions
-from ..runtime.errors import InputError, excerpt, unknown_key
-from ..runtime.paths import refuse_overwriting_inputs
-from ..solver.settings import parse_mapping
-from .batch_rows import Job
+from ...io.documents import load_document
+from ...io.handles import referenced_files
+from ...io.mesh.formats import extensions
+from ...runtime.errors import InputError, excerpt, unknown_key
+from ...runtime.paths import refuse_overwriting_inputs
+from ...solver.settings import parse_mapping
+from .rows import Job
 
 TOP_KEYS = ("jobs", "defaults")
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")

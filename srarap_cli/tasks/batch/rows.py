@@ -3,8 +3,8 @@ died), and the interruption that carries every job's result."""
 import os
 from typing import Any
 
-from .job import DeformJob, JobResult, JobStatus, recorded_result
-from .job_record import sidecar_path
+from ..job import DeformJob, JobResult, JobStatus, recorded_result
+from ..job_record import sidecar_path
 from .worker_pool import death_note
 
 #: a job of a manifest: name, absolute paths, output, settings, expect
