@@ -47,7 +47,7 @@ def make_deformer(V: ArrayLike, F: ArrayLike, constrained: ArrayLike,
                                       cache=cache, area=area)
 
 
-def deform(V: ArrayLike, F: ArrayLike, constrained: ArrayLike, targets: ArrayLike, *,
+def deform_arrays(V: ArrayLike, F: ArrayLike, constrained: ArrayLike, targets: ArrayLike, *,
            initial: tuple[np.ndarray, np.ndarray] | None = None,
            callback: Callable[[dict], None] | None = None, cache: str | None = None,
            settings: Settings | None = None, **options: Any) -> DeformResult:
@@ -74,7 +74,7 @@ def deform(V: ArrayLike, F: ArrayLike, constrained: ArrayLike, targets: ArrayLik
     --------
     >>> import numpy as np
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
-    >>> r = deform(V, [[0, 1, 2], [1, 3, 2]], [0, 1, 2, 3], V + 1.0, time_limit=5)
+    >>> r = deform_arrays(V, [[0, 1, 2], [1, 3, 2]], [0, 1, 2, 3], V + 1.0, time_limit=5)
     >>> r.converged, r.stop_reason.value
     (True, 'converged')
     """

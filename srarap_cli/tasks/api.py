@@ -8,7 +8,7 @@ import numpy as np
 from ..io.handles import as_constraints
 from ..io.mesh.mesh import Mesh
 from ..solver.api_checks import mesh_like
-from ..solver.oneshot import deform as deform_arrays
+from ..solver.oneshot import deform_arrays
 from ..solver.result import DeformResult
 from ..solver.settings import STAGES, Settings, keywords, resolve
 from .pipeline import deform_mesh
@@ -44,7 +44,7 @@ def deform(mesh: Any, handles: Any, *arrays: Any,
     Notes
     -----
     The array form ``deform(V, F, constrained, targets, initial=..., ...)`` of
-    :func:`srarap_cli.solver.oneshot.deform` is accepted too (a warm start needs it, or a
+    :func:`srarap_cli.solver.oneshot.deform_arrays` is accepted too (a warm start needs it, or a
     :class:`~srarap_cli.solver.deformer.Deformer`).
 
     Examples

@@ -5,7 +5,7 @@ import os
 import re
 import string
 
-from ..io.mesh.formats import extensions
+from ..io.mesh.formats import extensions, suffix_of
 from ..runtime.errors import InputError, OutputError, UsageProblem
 
 #: frames an animation may have unless raised on purpose (a typo in --fps or a keyframe time
@@ -53,7 +53,7 @@ def _fields(pattern):
 
 def suffix(pattern: str) -> str:
     """The frames' extension, lower-case (``.obj``)."""
-    return os.path.splitext(pattern.format(0))[1].lower()
+    return suffix_of(pattern.format(0))
 
 
 def frame_count(frames: int | None, last_key_frame: float, max_frames: int, handles: str,

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..io.handles import Constraints, load_handles, referenced_files
 from ..io.mesh import MeshFormat, open_mesh
+from ..io.mesh.formats import suffix_of
 from ..io.mesh.mesh import Mesh
 from ..io.mesh.meshio_formats import needs
 from ..io.mesh.stream import read_mesh_stream
@@ -23,8 +24,8 @@ def check_output_path(path: str, allowed: Sequence[str] | None, what: str) -> No
     extensions; None when the format is given otherwise). A missing folder is not a failure:
     every command makes the missing folders of its outputs when it writes them. A device or
     a descriptor (``/dev/stdout``, ``/dev/null``) is written through whatever its name."""
-    ext = os.path.splitext(path)[1].lower()
-    if allowed is not None and ext not in allowed and (hint := needs(ext)):
+    ext = suffix_of(path)
+    if allowed is not None and ext not in allowed and (hint := needs(path)):
         raise InputError(f"{path}: {hint}")
     if allowed is not None and ext not in allowed and not _device(path):
         raise UsageProblem(f"{what} {path!r}: extension must be one of {', '.join(allowed)}")

@@ -7,7 +7,7 @@ import numpy as np
 from ...runtime.commit import atomic_write
 from ...runtime.errors import InputError, OutputError
 from ...runtime.limits import MAX_COORDINATE, check_read
-from .formats import HEAD_BYTES, MeshFormat, by_content, by_extension, extensions
+from .formats import HEAD_BYTES, MeshFormat, by_content, by_extension, extensions, suffix_of
 from .mesh import Mesh
 from .meshio_formats import needs
 from .sniff import not_a_mesh
@@ -41,7 +41,7 @@ def open_mesh(path: str | os.PathLike, fmt: MeshFormat | None = None
     if os.path.isdir(path):
         raise InputError(f"{path}: is a folder, not a mesh file")
     fmt = fmt or by_extension(path)
-    if fmt is None and (hint := needs(os.path.splitext(path)[1])):
+    if fmt is None and (hint := needs(path)):
         raise InputError(f"{path}: {hint}")
     if fmt is None:
         if not os.path.isfile(path):  # a pipe, a device, a process substitution: one pass
@@ -117,7 +117,7 @@ def format_mesh(mesh: Mesh, suffix: str, ascii: bool = False) -> tuple[bytes, li
 
 def _writable(suffix):
     fmt = by_extension("x" + suffix)
-    if fmt is None and (hint := needs(suffix)):
+    if fmt is None and (hint := needs("x" + suffix)):
         raise InputError(f"{suffix}: {hint}")
     if fmt is None:
         raise OutputError(f"cannot write {suffix or 'files without extension'}; "
@@ -148,10 +148,10 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh) -> list[str]:
 
         mesh = Mesh.from_arrays(*mesh_like(mesh))
     fmt = by_extension(str(path))
-    if fmt is None and (hint := needs(os.path.splitext(str(path))[1])):
+    if fmt is None and (hint := needs(str(path))):
         raise InputError(f"{path}: {hint}")
     if fmt is None:
-        suffix = os.path.splitext(str(path))[1].lower()
+        suffix = suffix_of(str(path))
         raise OutputError(f"{path}: cannot write {suffix or 'files without extension'}; "
                           f"use one of {_listed()}")
     data, lost = fmt.encode(mesh)

@@ -103,10 +103,24 @@ def extensions() -> list[str]:
     return [ext for fmt in FORMATS.values() for ext in fmt.extensions]
 
 
+def suffix_of(path: str) -> str:
+    """``path``'s extension, lower-case: the longest one a format claims (``.vol.gz``),
+    else the last one (``.txt``; "" for none).
+
+    Examples
+    --------
+    >>> suffix_of("out/Part.OBJ"), suffix_of("notes.txt"), suffix_of("README")
+    ('.obj', '.txt', '')
+    """
+    name = re.split(r"[/\\]", str(path))[-1].lower()
+    claimed = [ext for ext in extensions() if name.endswith(ext) and len(name) > len(ext)]
+    match = re.search(r"\.[^.]+$", name)
+    return max(claimed, key=len) if claimed else (match.group(0) if match else "")
+
+
 def by_extension(path: str) -> MeshFormat | None:
     """The format of ``path``'s extension (any case), or None."""
-    match = re.search(r"\.[^./\\]+$", str(path))
-    ext = match.group(0).lower() if match else ""
+    ext = suffix_of(path)
     return next((fmt for fmt in FORMATS.values() if ext in fmt.extensions), None)
 
 

@@ -5,7 +5,7 @@ import os
 
 from ...io.documents import load_document
 from ...io.handles import referenced_files
-from ...io.mesh.formats import extensions
+from ...io.mesh.formats import extensions, suffix_of
 from ...runtime.errors import InputError, excerpt, unknown_key
 from ...runtime.paths import refuse_overwriting_inputs
 from ...solver.settings import parse_mapping
@@ -79,7 +79,7 @@ def _output_name(where, value):
     if os.path.isabs(value) or norm == ".." or norm.startswith(".." + os.sep):
         raise InputError(f"{where}: output {excerpt(value)!r} must stay inside the output "
                          "folder (-o): no absolute path, no '..'")
-    if os.path.splitext(norm)[1].lower() not in extensions():
+    if suffix_of(norm) not in extensions():
         raise InputError(f"{where}: output {excerpt(value)!r} needs one of the extensions "
                          f"{', '.join(extensions())}")
     return norm
