@@ -21,23 +21,33 @@ class MultiresPart:
 
     Attributes
     ----------
-    coarse_vertices : int, vertices of the coarse mesh (a subset of the full mesh's)
-    cache_hit : bool, the coarse mesh came from the cache folder
-    iterations : int, iterations of the coarse solve (and the coarser ones inside it); 0
-        for a warm solve, which goes straight to full resolution
-    stop_reason : StopReason or None, why the coarse solve stopped (None: a warm solve)
-    transfer : bool, the result is the paper's transfer of the coarse solve (rotors spread
-        harmonically, one Poisson solve), not iterated at full resolution; the log then ends
-        with coarse iterations
-    full_energy : dict, ``membrane``, ``bending``, ``total`` of the returned full-resolution
-        positions and rotors
-    start_energy : dict, transfer only: the full-resolution energies of the rest shape with
-        the constrained vertices at their targets (what the approximation is judged against)
-    stages : dict, seconds per stage (keys of :data:`STAGE_NAMES`); the simplification and
-        the full-resolution setup run side by side, so they add up to more than ``wall``
-    memory : dict, peak resident bytes per stage (``setup``, then the solve's; None where the
-        platform cannot tell, see :mod:`srarap_cli.runtime.memory`)
-    wall : float, wall seconds of the solve (setup excluded)
+    coarse_vertices : int
+        Vertices of the coarse mesh (a subset of the full mesh's).
+    cache_hit : bool
+        The coarse mesh came from the cache folder.
+    iterations : int
+        Iterations of the coarse solve (and of the coarser ones inside it); 0 for a warm
+        solve, which goes straight to full resolution.
+    stop_reason : StopReason or None
+        Why the coarse solve stopped (None: a warm solve).
+    transfer : bool
+        The result is the paper's transfer of the coarse solve (rotors spread
+        harmonically, one Poisson solve), not iterated at full resolution; the log then
+        ends with coarse iterations.
+    full_energy : dict
+        ``membrane``, ``bending``, ``total`` of the returned full-resolution positions and
+        rotors.
+    start_energy : dict
+        Transfer only: the full-resolution energies of the rest shape with the constrained
+        vertices at their targets (what the approximation is judged against).
+    stages : dict
+        Seconds per stage (keys of :data:`STAGE_NAMES`); the simplification and the
+        full-resolution setup run side by side, so they add up to more than ``wall``.
+    memory : dict
+        Peak resident bytes per stage (``setup``, then the solve's; None where the platform
+        cannot tell, see :mod:`srarap_cli.runtime.memory`).
+    wall : float
+        Wall seconds of the solve (setup excluded).
     """
 
     coarse_vertices: int
@@ -69,24 +79,35 @@ class DeformResult:
     Attributes
     ----------
     positions : (n, 3) float array
-    rotors : (n, 4) float array, unit quaternions (w, x, y, z) of the vertex cells
-    log : list of dict, one per iteration (0 is the start), keys ``solve_log.LOG_FIELDS``; a
+        The deformed positions.
+    rotors : (n, 4) float array
+        Unit quaternions (w, x, y, z) of the vertex cells.
+    log : list of dict
+        One row per iteration (0 is the start), keys ``solve_log.LOG_FIELDS``; a
         multiresolution solve's holds the coarse iterations first (``step`` prefixed
-        ``coarse-``)
-    stop_reason : StopReason, why the solve stopped (see :mod:`srarap_cli.solver.stop`)
-    iterations : int, local/global iterations run at full resolution
-    stop_detail : str, for a solve stopped unconverged: which stopping test still failed,
-        with its numbers
-    faces : (f, 3) int array or None, the mesh's triangles when the result came from
-        :func:`srarap_cli.deform` on a mesh
-    warnings : list of str, what the input or the solve found worth a warning
-    multires : MultiresPart or None, the coarse solve's part (None: solved at full
-        resolution only)
-    converged : bool (property), the stopping test passed at full resolution
-    complete : bool (property), the solve ended as asked: converged, or ``tol`` 0 ran the
-        iterations asked; for the multiresolution transfer, its coarse solve did
-    approximate : bool (property), the result is the paper's transfer of a coarse solve
-    coarse_iterations : int (property), iterations on coarse meshes (0 without multires)
+        ``coarse-``).
+    stop_reason : StopReason
+        Why the solve stopped (see :mod:`srarap_cli.solver.stop`).
+    iterations : int
+        Local/global iterations run at full resolution.
+    stop_detail : str
+        For a solve stopped unconverged: which stopping test still failed, with its
+        numbers.
+    faces : (f, 3) int array or None
+        The mesh's triangles, when the result came from :func:`srarap_cli.deform` on a mesh.
+    warnings : list of str
+        What the input or the solve found worth a warning.
+    multires : MultiresPart or None
+        The coarse solve's part (None: solved at full resolution only).
+    converged : bool
+        Property: the stopping test passed at full resolution.
+    complete : bool
+        Property: the solve ended as asked (converged, or ``tol`` 0 ran the iterations
+        asked; for the multiresolution transfer, its coarse solve did).
+    approximate : bool
+        Property: the result is the paper's transfer of a coarse solve.
+    coarse_iterations : int
+        Property: iterations on coarse meshes (0 without multires).
 
     Examples
     --------
