@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from helpers import ROOT, SHARED, needs_shared, tube_mesh
 
-from srarap_cli.io.mesh import format_mesh, read_mesh, write_mesh
+from srarap_cli.io.mesh import FORMATS, Mesh, format_mesh, read_mesh, write_mesh
 from srarap_cli.io.mesh.normals import recompute_normals
 from srarap_cli.runtime.errors import InputError
 from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
@@ -28,6 +28,25 @@ def test_round_trip_keeps_vertices_and_polygons_exactly(tmp_path, suffix):
     back = read_mesh(path)
     assert np.array_equal(back.vertices, mesh.vertices)  # 17 significant digits / binary
     same_structure(back, mesh)
+
+
+def _triangles_in_space(mesh):
+    """The mesh's triangles as sorted corner coordinates: what every format keeps, whatever
+    it does to vertex order (STL welds corners) or polygons (split into triangles)."""
+    corners = mesh.vertices[mesh.triangles()[0]]
+    return sorted(tuple(sorted(map(tuple, t))) for t in corners.tolist())
+
+
+@pytest.mark.parametrize("name", sorted(FORMATS))
+def test_every_registered_format_keeps_the_surface(name, tmp_path):
+    """Every format of the table, the meshio ones included: the triangles come back at the
+    same coordinates (single-precision values, which STL stores exactly)."""
+    tube = tube_mesh(rings=3, segments=5)
+    V = (tube.vertices + np.random.default_rng(1).normal(size=tube.vertices.shape))
+    mesh = Mesh.from_arrays(V.astype(np.float32).astype(float), tube.triangles()[0])
+    path = tmp_path / f"m{FORMATS[name].extension}"
+    write_mesh(path, mesh)
+    assert _triangles_in_space(read_mesh(path)) == _triangles_in_space(mesh)
 
 
 def test_obj_keeps_uv_seams_normals_and_other_statements(tmp_path):
@@ -84,9 +103,9 @@ def test_normals_follow_the_deformation():
 @pytest.mark.slow
 def test_output_bytes_are_deterministic(tmp_path):
     mesh = read_mesh(os.path.join(ROOT, "sample_meshes", "spot.obj"))
-    for suffix in (".obj", ".off", ".ply"):
-        assert format_mesh(mesh, suffix)[0] == format_mesh(read_mesh(
-            os.path.join(ROOT, "sample_meshes", "spot.obj")), suffix)[0]
+    for fmt in FORMATS.values():
+        assert format_mesh(mesh, fmt.extension)[0] == format_mesh(read_mesh(
+            os.path.join(ROOT, "sample_meshes", "spot.obj")), fmt.extension)[0], fmt.name
 
 
 @needs_shared
