@@ -122,15 +122,15 @@ def test_one_result_type_with_an_optional_multiresolution_part():
     import srarap_cli
     from srarap_cli.solver.result import MultiresPart
 
-    spot = srarap_cli.read_mesh(f"{ROOT}/sample_meshes/spot.obj")
-    plain = srarap_cli.deform(spot, f"{ROOT}/configs/spot-nod.yaml", multires="off")
-    refined = srarap_cli.deform(spot, f"{ROOT}/configs/spot-nod.yaml", multires=1500)
-    moved = srarap_cli.deform(spot, f"{ROOT}/configs/spot-nod.yaml", multires=1500,
-                              multires_mode="transfer")
+    bar = srarap_cli.read_mesh(f"{ROOT}/sample_meshes/bar.obj")
+    twist = f"{ROOT}/configs/bar-twist.yaml"
+    plain = srarap_cli.deform(bar, twist, multires="off")
+    refined = srarap_cli.deform(bar, twist, multires=150)
+    moved = srarap_cli.deform(bar, twist, multires=150, multires_mode="transfer")
     assert type(plain) is type(refined) is type(moved) is srarap_cli.DeformResult
     assert plain.multires is None and plain.coarse_iterations == 0 and not plain.approximate
     for r in (refined, moved):
-        assert isinstance(r.multires, MultiresPart) and r.multires.coarse_vertices <= 1500
+        assert isinstance(r.multires, MultiresPart) and r.multires.coarse_vertices <= 150
         assert r.coarse_iterations == r.multires.iterations > 0 and r.multires.converged
     assert not refined.approximate and moved.approximate and moved.complete
     assert refined.energies() == {k: refined.log[-1][k] for k in ("membrane", "bending", "total")}

@@ -49,6 +49,7 @@ def test_a_format_writes_and_reads_back_exactly(name, faces, tmp_path, capsys):
         assert np.array_equal(back.vertex_data["weight"], mesh.vertex_data["weight"])
 
 
+@pytest.mark.slow
 def test_every_format_writes_the_same_bytes_a_second_later(tmp_path):
     """Determinism, where a writer stamps the time (Exodus, H5M) or gzip the mtime."""
     bar = read_mesh(BAR)
