@@ -21,13 +21,12 @@ experiments patch the correction at run time (nothing of them is shipped): ``--e
 correction every iteration), ``--coarse-steps`` / ``--nested-steps`` (the correction's coarse
 steps), ``--scale`` (the correction times a factor), ``--kappa`` (the averaged residual
 times a factor before the coarse solve), ``--smooth`` (neighbour-averaging sweeps of the
-correction), ``--choose W`` (the lower energy of the corrected rotors and of W times the
 correction). The tight solves are kept in ``out/tight-<case>.npz``: delete them when the
 solver changes.
 
 Run: python benchmarks/multires_error_split.py [--cases spot46k,spot184k,bar500k]
      [--no-table] [--every 1] [--coarse-steps N] [--nested-steps N] [--scale S] [--kappa K]
-     [--smooth N] [--choose W]
+     [--smooth N]
 """
 import argparse
 import os
@@ -143,49 +142,6 @@ def gains(corrections, best, cells, count):
     return out
 
 
-def choosing(weight):
-    """Experiment: where a correction is due, the driver tries the mixed rotors plus the
-    correction and plus ``weight`` times it, and keeps the lower energy (one more Poisson
-    solve and local step per correction); otherwise the shipped Anderson iteration."""
-    from srarap_cli.solver.drivers import anderson as a
-    from srarap_cli.solver.multires import deformer as md
-
-    def iteration(step, state, monitor, depth=None, correction=None):
-        mixer = a.AndersonMixer(depth or a.DEFAULT_DEPTH)
-        x = state
-        current = step.with_rotors(x, step.local(x))
-        stop = monitor.record(current, kind="start")
-        while not stop:
-            R = current.rotors
-            g = a.align_hemisphere(R, x.rotors)
-            residual = g - x.rotors
-            flat = g.ravel()
-            mixed = mixer.mix(flat, residual.ravel())
-            kind = "anderson" if mixed is not flat else None
-            mixed = mixed.reshape(g.shape)
-            delta = None
-            if correction is not None and correction.due(x.iteration + 1):
-                delta = correction(x.rotors, residual)
-            tries = [mixed] if delta is None else [mixed + delta, mixed + weight * delta]
-            kind = kind if delta is None else "corrected"
-            best = None
-            if kind:
-                for rotors in tries:
-                    R_new = a.align_hemisphere(a.normalize(rotors, R), R)
-                    pair = a._local(step, step.positions(R_new), R_new, x.iteration + 1)
-                    if best is None or pair[1].total < best[1].total:
-                        best = pair
-                candidate, tried = best
-                if tried.total > current.total + a.ROUNDING * abs(tried.stretch_total):
-                    kind = "fallback"
-            if kind in (None, "fallback"):
-                candidate, tried = a._local(step, step.positions(R), R, x.iteration + 1)
-            stop = monitor.record(tried, current, kind=kind or "plain")
-            x, current = candidate, tried
-        return current
-    md.anderson_iteration = iteration
-
-
 SMOOTH = {"sweeps": 0, "graph": None}
 
 
@@ -297,12 +253,8 @@ def main():
     ap.add_argument("--kappa", type=float, default=None,
                     help="experiment: the averaged residual scaled before the coarse solve")
     ap.add_argument("--smooth", type=int, default=0, help="experiment: smoothing sweeps")
-    ap.add_argument("--choose", type=float, default=None,
-                    help="experiment: also try the correction times this, keep the lower energy")
     ap.add_argument("--no-table", action="store_true")
     args = ap.parse_args()
-    if args.choose:
-        choosing(args.choose)
     variant(args.every, args.coarse_steps, args.nested_steps, args.scale, args.kappa)
     if args.smooth:
         smoothing(args.smooth)

@@ -164,9 +164,9 @@ class DeformResult:
 
     @property
     def complete(self) -> bool:
-        if self.approximate:
-            coarse = self.multires.stop_reason  # type: ignore[union-attr]
-            return coarse is not None and coarse.complete
+        part = self.multires
+        if part is not None and part.transfer:
+            return part.stop_reason is not None and part.stop_reason.complete
         return self.stop_reason.complete
 
     def energies(self) -> dict[str, float]:
