@@ -21,12 +21,13 @@ experiments patch the correction at run time (nothing of them is shipped): ``--e
 correction every iteration), ``--coarse-steps`` / ``--nested-steps`` (the correction's coarse
 steps), ``--scale`` (the correction times a factor), ``--kappa`` (the averaged residual
 times a factor before the coarse solve), ``--smooth`` (neighbour-averaging sweeps of the
-correction). The tight solves are kept in ``out/tight-<case>.npz``: delete them when the
-solver changes.
+correction), ``--galerkin`` (the Galerkin correction of ``galerkin_correction.py`` instead,
+``--aggregates N`` its largest aggregate count). The tight solves are kept in
+``out/tight-<case>.npz``: delete them when the solver changes.
 
 Run: python benchmarks/multires_error_split.py [--cases spot46k,spot184k,bar500k]
      [--no-table] [--every 1] [--coarse-steps N] [--nested-steps N] [--scale S] [--kappa K]
-     [--smooth N]
+     [--smooth N] [--galerkin [--aggregates N]]
 """
 import argparse
 import os
@@ -78,25 +79,35 @@ class Recorder:
         self.corrections, self.module = [], correction
         self.call = call = correction.CoarseCorrection.__call__
 
-        def corrected(corr, rotors, residual):
-            out = call(corr, rotors, residual)
-            if len(rotors) == recorder.n and out is not None:
-                # the driver adds the correction to its mixed rotors (its caller's local)
-                mixed = sys._getframe(1).f_locals["mixed"]
-                recorder.corrections.append((mixed.copy(), out.copy()))
+        def keep(state, out, driver):
+            if len(state.rotors) == recorder.n and out is not None:
+                # the driver adds the correction to its mixed rotors (its local)
+                recorder.corrections.append((driver.f_locals["mixed"].copy(), out.copy()))
             return out
+
+        def corrected(corr, state, residual):
+            return keep(state, call(corr, state, residual), sys._getframe(1))
         correction.CoarseCorrection.__call__ = corrected
+        import galerkin_correction
+        self.galerkin = newton = galerkin_correction.GalerkinCorrection.__call__
+
+        def galerkin(corr, state, residual):
+            return keep(state, newton(corr, state, residual), sys._getframe(1))
+        galerkin_correction.GalerkinCorrection.__call__ = galerkin
 
     def stop(self):
+        import galerkin_correction
         monitor.Monitor.record = self.real
         self.module.CoarseCorrection.__call__ = self.call
+        galerkin_correction.GalerkinCorrection.__call__ = self.galerkin
 
 
 def variant(every=None, coarse_steps=None, nested_steps=None, scale=None, kappa=None):
     """Patch the correction's constants for an experiment (None: as shipped)."""
     from srarap_cli.solver.multires import correction as c
     if kappa:
-        def scaled_residual(self, rotors, residual):
+        def scaled_residual(self, state, residual):
+            rotors = state.rotors
             y0 = rotors[self.vertices]
             r = self._average(residual)
             tau = self._map(y0) - y0 - kappa * r
@@ -116,8 +127,8 @@ def variant(every=None, coarse_steps=None, nested_steps=None, scale=None, kappa=
     if scale:
         call = c.CoarseCorrection.__call__
 
-        def scaled(self, rotors, residual):
-            out = call(self, rotors, residual)
+        def scaled(self, state, residual):
+            out = call(self, state, residual)
             return None if out is None else out * scale
         c.CoarseCorrection.__call__ = scaled
 
@@ -153,10 +164,10 @@ def smoothing(sweeps):
     SMOOTH["sweeps"] = sweeps
     call = c.CoarseCorrection.__call__
 
-    def smoothed(self, rotors, residual):
-        out = call(self, rotors, residual)
+    def smoothed(self, state, residual):
+        out = call(self, state, residual)
         graph = SMOOTH["graph"]
-        if out is None or graph is None or len(rotors) != graph.shape[0]:
+        if out is None or graph is None or len(state.rotors) != graph.shape[0]:
             return out
         for _ in range(SMOOTH["sweeps"]):
             out = 0.5 * (out + graph @ out)
@@ -253,8 +264,17 @@ def main():
     ap.add_argument("--kappa", type=float, default=None,
                     help="experiment: the averaged residual scaled before the coarse solve")
     ap.add_argument("--smooth", type=int, default=0, help="experiment: smoothing sweeps")
+    ap.add_argument("--galerkin", action="store_true",
+                    help="experiment: the Galerkin correction of galerkin_correction.py")
+    ap.add_argument("--aggregates", type=int, default=None,
+                    help="experiment: the Galerkin correction's MAX_AGGREGATES")
     ap.add_argument("--no-table", action="store_true")
     args = ap.parse_args()
+    if args.galerkin:
+        import galerkin_correction
+        galerkin_correction.install()
+        if args.aggregates:
+            galerkin_correction.MAX_AGGREGATES = args.aggregates
     variant(args.every, args.coarse_steps, args.nested_steps, args.scale, args.kappa)
     if args.smooth:
         smoothing(args.smooth)

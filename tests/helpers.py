@@ -102,6 +102,19 @@ def twist(V, ids, length, degrees):
     return T
 
 
+def bent_tube(tol=1e-10):
+    """A 54-vertex tube with one end held and the other moved sideways and down, solved to
+    ``tol``: (Deformer, targets, result)."""
+    from srarap_cli import Deformer
+
+    V, F = tube(rings=8, segments=6)
+    ids = ends(V)
+    d = Deformer(V, F, ids)
+    T = V[ids].copy()
+    T[T[:, 2] > 1] += [1.0, 0.0, -0.5]
+    return d, T, d.solve(T, tol=tol, max_iter=500)
+
+
 def diagonal(V):
     return float(np.linalg.norm(np.ptp(V, axis=0)))
 

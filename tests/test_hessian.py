@@ -2,10 +2,9 @@
 and the invariances it must have."""
 import numpy as np
 import pytest
-from helpers import ends, tube
+from helpers import bent_tube
 
-from srarap_cli import Deformer
-from srarap_cli.solver.hessian import energy_hessian
+from srarap_cli.solver.hessian import energy_hessian, rotor_gradient
 from srarap_cli.solver.quaternion import IDENTITY, from_rotation_vectors, multiply
 
 
@@ -13,12 +12,8 @@ from srarap_cli.solver.quaternion import IDENTITY, from_rotation_vectors, multip
 def state():
     """A bent tube's solve, then every position and rotor perturbed (so the residual terms of
     the Hessian, which vanish on an exact fit, are exercised)."""
-    V, F = tube(rings=8, segments=6)
-    ids = ends(V)
-    d = Deformer(V, F, ids)
-    T = V[ids].copy()
-    T[T[:, 2] > 1] += [1.0, 0.0, -0.5]
-    r = d.solve(T, tol=1e-10, max_iter=500)
+    d, _, r = bent_tube()
+    V = d.V
     rng = np.random.default_rng(3)
     P = r.positions + 0.05 * rng.standard_normal(V.shape)
     R = multiply(from_rotation_vectors(0.2 * rng.standard_normal((len(V), 3))), r.rotors)
@@ -100,3 +95,55 @@ def test_edge_blocks_give_the_same_products(state, monkeypatch):
     for name, x in (("rotations", w), ("coupling", u), ("coupling_t", w)):
         a, b = getattr(whole, name)(x), getattr(blocked, name)(x)
         assert np.allclose(a, b, rtol=0, atol=1e-12 * np.abs(a).max()), name
+
+
+def test_the_rotor_gradient_matches_finite_differences_of_the_energy(state):
+    """Half the energy's slope along any turn of the rotors (membrane and bending)."""
+    d, P, R, rng = state
+    g = rotor_gradient(d.graph, d.edges, P, R, d.bending_weight)
+    for _ in range(3):
+        w = rng.standard_normal((len(P), 3))
+
+        def energy(t, w=w):
+            return d.energy(P, multiply(from_rotation_vectors(t * w), R))["total"]
+
+        h = 1e-5
+        slope = (energy(h) - energy(-h)) / (2 * h)
+        assert 2.0 * np.sum(w * g) == pytest.approx(slope, rel=1e-7)
+
+
+def test_the_rotor_gradient_vanishes_at_rest_and_is_blind_to_a_rotor_sign(state):
+    d, P, R, rng = state
+    V = d.V
+    rest = rotor_gradient(d.graph, d.edges, V, np.tile(IDENTITY, (len(V), 1)), d.bending_weight)
+    assert np.abs(rest).max() < 1e-13
+    flipped = R.copy()
+    flipped[::3] *= -1
+    assert np.allclose(rotor_gradient(d.graph, d.edges, P, flipped, d.bending_weight),
+                       rotor_gradient(d.graph, d.edges, P, R, d.bending_weight), atol=1e-13)
+
+
+def test_the_blocks_are_the_products(state):
+    """The 3x3 blocks, put in a sparse matrix by hand, multiply as the products do."""
+    import scipy.sparse as sp
+
+    d, P, R, rng = state
+    H = energy_hessian(d.graph, d.edges, P, R, d.bending_weight)
+    g, n = d.graph, len(P)
+    key = g.I * n + g.J
+    reverse = np.array([int(np.flatnonzero(key == j * n + i)[0]) for i, j in zip(g.I, g.J)])
+    ww_diagonal, ww_edges, wu_diagonal, wu_edges = H.blocks(reverse)
+
+    def assemble(diagonal, edges):
+        M = np.zeros((3 * n, 3 * n))
+        for i in range(n):
+            M[3 * i:3 * i + 3, 3 * i:3 * i + 3] += diagonal[i]
+        for e, (i, j) in enumerate(zip(g.I, g.J)):
+            M[3 * i:3 * i + 3, 3 * j:3 * j + 3] += edges[e]
+        return sp.csr_matrix(M)
+
+    u, w = rng.standard_normal((2, n, 3))
+    ww, wu = assemble(ww_diagonal, ww_edges), assemble(wu_diagonal, wu_edges)
+    assert np.allclose(ww @ w.ravel(), H.rotations(w).ravel(), atol=1e-12)
+    assert np.allclose(wu @ u.ravel(), H.coupling(u).ravel(), atol=1e-12)
+    assert np.allclose(wu.T @ w.ravel(), H.coupling_t(w).ravel(), atol=1e-12)

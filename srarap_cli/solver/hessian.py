@@ -1,4 +1,5 @@
-"""Second derivatives of the SR-ARAP energy at one state, as matrix-free products.
+"""Second derivatives of the SR-ARAP energy at one state, as matrix-free products or as 3x3
+blocks, and its first derivative in the rotors (:func:`rotor_gradient`).
 
 The variables are the positions' increments ``u`` (n, 3) and the rotors' increments ``w``
 (n, 3), a rotor moving as ``R -> exp(w / 2) R`` (its rotation turned by the vector ``w``
@@ -90,6 +91,24 @@ class EnergyHessian:
         """Per-vertex sums (n, 3) of per-edge rows (3, k) by ``labels``."""
         return label_sum(rows.T, labels, self.n)
 
+    def blocks(self, reverse: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The 3x3 blocks of ``Q_ww`` and ``Q_wu``: per vertex (its diagonal block) and per
+        directed edge ``i -> j`` (the block of row ``i``, column ``j``).
+
+        Parameters
+        ----------
+        reverse : (m,) int array, the edge ``j -> i`` of each edge ``i -> j``
+
+        Returns
+        -------
+        ww_diagonal : (n, 3, 3); ww_edges : (m, 3, 3); wu_diagonal : (n, 3, 3);
+        wu_edges : (m, 3, 3)
+        """
+        w, d = self._beta_w, self._beta_v.T
+        ww_edges = _skew(d - d[reverse])
+        ww_edges -= (w + w[reverse])[:, None, None] * np.eye(3)
+        return self._cells, ww_edges, _skew(self._ca_sums), -_skew(self._ca.T)
+
 
 def energy_hessian(graph: CellGraph, edges: RestEdges, P: np.ndarray, R: np.ndarray, bending_weight: float
                    ) -> EnergyHessian:
@@ -149,6 +168,59 @@ def energy_hessian(graph: CellGraph, edges: RestEdges, P: np.ndarray, R: np.ndar
         :, None, None] * np.eye(3)
     return EnergyHessian(n, graph.I, graph.J, blocks, ca,
                          np.einsum("nab,nb->na", Rm, edges.sum_cq), cells, beta_w, beta_v)
+
+
+def rotor_gradient(graph: CellGraph, edges: RestEdges, P: np.ndarray, R: np.ndarray,
+                   bending_weight: float) -> np.ndarray:
+    """Half the gradient of the SR-ARAP energy in the rotors' increments ``w`` (a rotor
+    moving as ``R -> exp(w / 2) R``) at positions ``P`` and rotors ``R``: (n, 3).
+
+    The membrane part of row ``i`` is ``-sum_j c_ij a_ij x p_ij`` (``a_ij = R_i q_ij R_i~``,
+    ``p_ij = p_j - p_i``); an edge ``i -> j`` of the bending term, weight ``B = bending_weight
+    / deg_i`` and relative rotor ``D = s R_j R_i~`` (hemisphere aligned), adds ``-B vec(D) / 2``
+    to row ``i`` and ``B vec(D) / 2`` to row ``j``.
+
+    Parameters
+    ----------
+    graph : CellGraph; edges : RestEdges of the graph
+    P : (n, 3) float array; R : (n, 4) float array, unit quaternions
+    bending_weight : float, ``alpha * A``
+
+    Examples
+    --------
+    >>> from srarap_cli.solver.operators import cell_graph
+    >>> from srarap_cli.solver.rest_edges import RestEdges
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> g = cell_graph(V, np.array([[0, 1, 2]]), "uniform")
+    >>> R = np.tile([1., 0, 0, 0], (3, 1))   # the rest shape is the minimum
+    >>> bool(np.abs(rotor_gradient(g, RestEdges(g, V), V, R, 1.0)).max() < 1e-15)
+    True
+    """
+    n = graph.n
+    rows, rest = np.ascontiguousarray(R.T), np.ascontiguousarray(edges.rest_positions.T)
+    positions = np.ascontiguousarray(P.T)
+    out = np.zeros((n, 3))
+    for e in graph.edge_blocks():
+        I, J = graph.I[e], graph.J[e]
+        Ri = np.take(rows, I, axis=1)
+        q = np.take(rest, J, axis=1) - np.take(rest, I, axis=1)
+        p = np.take(positions, J, axis=1) - np.take(positions, I, axis=1)
+        out -= label_sum(_cross(graph.c[e] * rotate(Ri.T, q.T).T, p).T, I, n)
+        if bending_weight:
+            Rj = np.take(rows, J, axis=1)
+            dots = np.einsum("km,km->m", Ri, Rj)
+            half = (bending_weight / 2.0 / np.take(graph.degree, I)) * np.where(dots < 0, -1.0, 1.0)
+            vec = half * (Ri[0] * Rj[1:] - Rj[0] * Ri[1:] + _cross(Ri[1:], Rj[1:]))
+            out += label_sum(vec.T, J, n) - label_sum(vec.T, I, n)
+    return out
+
+
+def _skew(v):
+    """``[v]x`` (k, 3, 3) of vectors ``v`` (k, 3)."""
+    out = np.zeros((len(v), 3, 3))
+    out[:, 0, 1], out[:, 0, 2], out[:, 1, 2] = -v[:, 2], v[:, 1], -v[:, 0]
+    out[:, 1, 0], out[:, 2, 0], out[:, 2, 1] = v[:, 2], -v[:, 1], v[:, 0]
+    return out
 
 
 def _cross(a, b):

@@ -163,8 +163,8 @@ def anderson_iteration(step: LocalGlobalStep, state: State, monitor: Monitor,
     monitor : Monitor
     depth : int, Anderson history length (default DEFAULT_DEPTH)
     correction : optional, adds to the rotors of the iterates it is ``due`` for (numbered
-        from 1): ``correction(rotors, residual)`` gives (n, 4) or None from an iterate's
-        rotors and its step's rotor residual (a
+        from 1): ``correction(state, residual)`` gives (n, 4) or None from an iterate and
+        its step's rotor residual (a
         :class:`~srarap_cli.solver.multires.correction.CoarseCorrection`)
 
     Returns
@@ -186,7 +186,7 @@ def anderson_iteration(step: LocalGlobalStep, state: State, monitor: Monitor,
         mixed = mixed.reshape(g.shape)
         delta = None
         if correction is not None and correction.due(x.iteration + 1):
-            delta = correction(x.rotors, residual)
+            delta = correction(x, residual)
         if delta is not None:
             kind, mixed = "corrected", mixed + delta
         if kind:

@@ -25,6 +25,7 @@ import numpy as np
 from ..drivers.anderson import AndersonMixer
 from ..group_rotations import label_sum
 from ..quaternion import align_hemisphere, normalize
+from ..state import State
 from ..step import LocalGlobalStep
 
 #: coarse steps per correction (Anderson-mixed); 10 took the 46k Spot to 1e-4 in 24
@@ -78,18 +79,23 @@ class CoarseCorrection:
         """Whether the iterate numbered ``iteration`` gets a correction."""
         return iteration % self.every == 0
 
-    def __call__(self, rotors: np.ndarray, residual: np.ndarray) -> np.ndarray | None:
-        """The correction (n, 4) to add to the rotors of the iterate after ``rotors``.
+    def __call__(self, state: State, residual: np.ndarray) -> np.ndarray | None:
+        """The correction (n, 4) to add to the rotors of the iterate after ``state``.
 
         Parameters
         ----------
-        rotors : (n, 4) float array, the iterate's rotors
-        residual : (n, 4) float array, its step's rotors minus ``rotors`` (same hemispheres)
+        state : State, the iterate (its rotors are what the correction reads)
+        residual : (n, 4) float array, its step's rotors minus its rotors (same hemispheres)
 
         Returns
         -------
         (n, 4) float array, zero outside the cells; None when the coarse iteration failed
         """
+        return self.of_rotors(state.rotors, residual)
+
+    def of_rotors(self, rotors: np.ndarray, residual: np.ndarray) -> np.ndarray | None:
+        """The correction from an iterate's rotors (n, 4) alone (see :meth:`__call__`); a
+        nested level's iterates have no positions."""
         y0 = rotors[self.vertices]
         r = self._average(residual)
         tau = self._map(y0) - y0 - r
@@ -118,7 +124,7 @@ class CoarseCorrection:
             f = g - y
             mixed = mixer.mix(g.ravel(), f.ravel()).reshape(y.shape)
             if self.inner is not None and self.inner.due(k):
-                delta = self.inner(y, f)
+                delta = self.inner.of_rotors(y, f)
                 mixed = mixed if delta is None else mixed + delta
             new = normalize(mixed, y)
             settled = np.abs(new - y).max(initial=0.0) <= COARSE_SETTLED

@@ -52,9 +52,9 @@ class _Delayed:
         self.correction = self.correction or self.make()
         return self.correction.due(iteration)
 
-    def __call__(self, rotors: np.ndarray, residual: np.ndarray) -> np.ndarray | None:
+    def __call__(self, state: Any, residual: np.ndarray) -> np.ndarray | None:
         assert self.correction is not None  # due() came first
-        return self.correction(rotors, residual)
+        return self.correction(state, residual)
 
 
 def _all_iterations(result):
