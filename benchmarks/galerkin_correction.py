@@ -4,6 +4,9 @@ scheme (``srarap_cli/solver/multires/correction.py``). Not shipped: see "A Galer
 operator" in docs/background/performance.md for what it gained and what it cost.
 ``install()`` makes every MultiresDeformer use it (``multires_error_split.py --galerkin``).
 
+Run: python benchmarks/galerkin_correction.py [--cases spot46k,cylinder1m] [--aggregates N]
+(whole solves, shipped then Galerkin, and how far apart they end)
+
 Started from the coarse solution, the full-resolution iteration still converges slowly in
 the smooth components of its error (more than 99.9% of it; see the performance page). Those
 are what a coarse space can hold: with ``P`` (n, m) a smooth prolongation from ``m``
@@ -252,3 +255,61 @@ def install() -> None:
         return GalerkinCorrection(space, md.fine.step_for(targets, tol))
 
     MultiresDeformer.coarse_correction = coarse_correction
+
+
+def _run(name, galerkin):
+    """One default solve of a benchmark case (those of ``multires_error_split.py``)."""
+    import time
+
+    from multires_error_split import _case
+
+    from srarap_cli.io.handles import load_handles
+    from srarap_cli.io.mesh import read_mesh
+    from srarap_cli.solver.oneshot import make_deformer
+    from srarap_cli.solver.settings import resolve
+    from srarap_cli.tasks.pipeline import problem
+
+    mesh_path, handles_path = _case(name)
+    mesh = read_mesh(mesh_path)
+    handles = load_handles(handles_path, mesh.vertices)
+    p = problem(mesh, handles, mesh_path)
+    start = time.perf_counter()
+    d = make_deformer(p.V, p.F, p.ids, settings=resolve(handles.solver))
+    setup, start = time.perf_counter() - start, time.perf_counter()
+    r = d.solve(p.targets)
+    label = "Galerkin" if galerkin else "shipped"
+    print(f"{name} {label}: setup {setup:.1f} s, solve {time.perf_counter() - start:.1f} s, "
+          f"{r.iterations} iterations (+ {r.multires.iterations} coarse), energy "
+          f"{r.energy:.10g}, {r.stop_reason}; stages " + ", ".join(
+              f"{k} {v:.1f}" for k, v in r.multires.stages.items()), flush=True)
+    return r
+
+
+def main():
+    """Whole solves, the shipped correction then this one (one process each would be
+    fairer to memory; the times are the solves'), and how far apart their shapes end."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=main.__doc__.splitlines()[0])
+    ap.add_argument("--cases", default="cylinder1m")
+    ap.add_argument("--aggregates", type=int, default=None, help="MAX_AGGREGATES")
+    args = ap.parse_args()
+    if args.aggregates:
+        globals()["MAX_AGGREGATES"] = args.aggregates
+    for name in args.cases.split(","):
+        shipped = _run(name, False)
+        install()
+        ours = _run(name, True)
+        P = shipped.positions
+        diagonal = float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
+        far = float(np.sqrt(np.einsum("ij,ij->i", ours.positions - P, ours.positions - P).max()))
+        print(f"{name}: energies {(ours.energy - shipped.energy) / shipped.energy:+.1e} apart "
+              f"(relative), shapes {far / diagonal:.1e} of the diagonal", flush=True)
+
+
+if __name__ == "__main__":
+    import os
+    import sys
+
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    main()
