@@ -46,7 +46,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from srarap_cli.solver.hessian import energy_hessian, rotor_gradient
-from srarap_cli.solver.linalg import factor
+from srarap_cli.solver.linalg import _rslab_solver, factor
 from srarap_cli.solver.one_triangle import rslab_factor
 from srarap_cli.solver.quaternion import from_rotation_vectors, multiply
 from srarap_cli.solver.state import State
@@ -139,7 +139,7 @@ class GalerkinCorrection:
         self.space, self.step = space, step
         self._solve: Any = None
         self._kept: np.ndarray | None = None
-        self._last, self._done, self._fresh = float("inf"), False, False
+        self._last, self._done = float("inf"), False
 
     def due(self, iteration: int) -> bool:
         """Whether the iterate numbered ``iteration`` (from 1) gets a correction."""
@@ -150,15 +150,14 @@ class GalerkinCorrection:
         (whose positions are the global step's for its rotors); None when there is none.
         ``residual`` (the step's rotors minus the state's) is not used: the gradient says
         more."""
-        w = self._newton(state, fresh=self._solve is None)
-        size = float(np.abs(w).max(initial=0.0)) if w is not None else np.inf
-        if size > SHRINK * self._last and not self._fresh:
-            w = self._newton(state, fresh=True)  # the operator may be stale: once more
-            size = float(np.abs(w).max(initial=0.0)) if w is not None else np.inf
-        if w is None or size > SHRINK * self._last:
+        fresh = self._solve is None
+        w = self._newton(state, fresh)
+        if _size(w) > SHRINK * self._last and not fresh:
+            w = self._newton(state, True)  # the operator may be stale: once more
+        if _size(w) > SHRINK * self._last:
             self._done = True
             return None
-        self._last = size
+        self._last = _size(w)
         return multiply(from_rotation_vectors(w), state.rotors) - state.rotors
 
     def _newton(self, state, fresh):
@@ -166,7 +165,6 @@ class GalerkinCorrection:
         finite), with the coarse operator of ``state`` when ``fresh``."""
         d = self.step.deformer
         P, R = state.positions, state.rotors
-        self._fresh = fresh
         if fresh:
             self._factor(energy_hessian(d.graph, d.edges, P, R, d.bending_weight))
         assert self._kept is not None
@@ -187,14 +185,8 @@ class GalerkinCorrection:
         # Newton step needs no more digits. SuperLU where rslab refuses (not positive definite)
         scale = float(abs(A).max())
         ldlt = rslab_factor(A / scale, single=True)
-        if ldlt is None:
-            self._solve = factor(A, symmetric=True)
-            return
-
-        def solve(b):
-            size = float(np.abs(b).max()) or 1.0
-            return ldlt.solve(np.ascontiguousarray(b / size)) * (size / scale)
-        self._solve = solve
+        self._solve = (factor(A, symmetric=True) if ldlt is None
+                       else _rslab_solver(ldlt, scale, single=True))
 
 
 class _BlockPattern:
@@ -220,6 +212,11 @@ class _BlockPattern:
         data = np.empty((self._indices.size, 3, 3))
         data[self._diagonal], data[self._edges] = diagonal, edges
         return sp.bsr_matrix((data, self._indices, self._indptr), shape=(3 * self._n,) * 2)
+
+
+def _size(w):
+    """The largest rotor increment of ``w`` (inf for None: no step)."""
+    return np.inf if w is None else float(np.abs(w).max(initial=0.0))
 
 
 def _blocked(M):

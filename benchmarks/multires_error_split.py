@@ -75,31 +75,30 @@ class Recorder:
                 recorder.rows.append((state.rotors.copy(), state.positions.copy(), state.total))
             return recorder.real(mon, state, previous, kind)
         monitor.Monitor.record = record
-        from srarap_cli.solver.multires import correction
-        self.corrections, self.module = [], correction
-        self.call = call = correction.CoarseCorrection.__call__
-
-        def keep(state, out, driver):
-            if len(state.rotors) == recorder.n and out is not None:
-                # the driver adds the correction to its mixed rotors (its local)
-                recorder.corrections.append((driver.f_locals["mixed"].copy(), out.copy()))
-            return out
-
-        def corrected(corr, state, residual):
-            return keep(state, call(corr, state, residual), sys._getframe(1))
-        correction.CoarseCorrection.__call__ = corrected
         import galerkin_correction
-        self.galerkin = newton = galerkin_correction.GalerkinCorrection.__call__
 
-        def galerkin(corr, state, residual):
-            return keep(state, newton(corr, state, residual), sys._getframe(1))
-        galerkin_correction.GalerkinCorrection.__call__ = galerkin
+        from srarap_cli.solver.multires import correction
+        self.corrections = []
+        # both corrections, so that a --galerkin run is recorded as well
+        self.patched = [(cls, cls.__call__) for cls in (correction.CoarseCorrection,
+                                                         galerkin_correction.GalerkinCorrection)]
+
+        def recorded(call):
+            def corrected(corr, state, residual):
+                out = call(corr, state, residual)
+                if len(state.rotors) == recorder.n and out is not None:
+                    # the driver adds the correction to its mixed rotors (its local)
+                    mixed = sys._getframe(1).f_locals["mixed"]
+                    recorder.corrections.append((mixed.copy(), out.copy()))
+                return out
+            return corrected
+        for cls, call in self.patched:
+            cls.__call__ = recorded(call)
 
     def stop(self):
-        import galerkin_correction
         monitor.Monitor.record = self.real
-        self.module.CoarseCorrection.__call__ = self.call
-        galerkin_correction.GalerkinCorrection.__call__ = self.galerkin
+        for cls, call in self.patched:
+            cls.__call__ = call
 
 
 def variant(every=None, coarse_steps=None, nested_steps=None, scale=None, kappa=None):

@@ -153,17 +153,10 @@ def energy_hessian(graph: CellGraph, edges: RestEdges, P: np.ndarray, R: np.ndar
     ca, beta_w, beta_v = np.empty((3, m)), np.empty(m), np.empty((3, m))
     blocks = graph.edge_blocks()
     for e in blocks:
-        I, J = graph.I[e], graph.J[e]
-        Ri, Rj = np.take(rows, I, axis=1), np.take(rows, J, axis=1)
-        dots = np.einsum("km,km->m", Ri, Rj)
-        beta = bending_weight / 4.0 / np.take(graph.degree, I)
-        # D = s R_j R_i~ with s the sign that aligns the pair: scalar |R_i.R_j|, vector
-        # s (w_i v_j - w_j v_i + v_i x v_j)
-        beta_w[e] = beta * np.abs(dots)
-        beta_v[:, e] = (beta * np.where(dots < 0, -1.0, 1.0)) * (
-            Ri[0] * Rj[1:] - Rj[0] * Ri[1:] + _cross(Ri[1:], Rj[1:]))
-        q = np.take(rest, J, axis=1) - np.take(rest, I, axis=1)
-        ca[:, e] = graph.c[e] * rotate(Ri.T, q.T).T
+        Ri, ca[:, e] = _rotated_edges(graph, e, rows, rest)
+        scalar, vector = _relative_rotors(Ri, np.take(rows, graph.J[e], axis=1))
+        beta = bending_weight / 4.0 / np.take(graph.degree, graph.I[e])
+        beta_w[e], beta_v[:, e] = beta * scalar, beta * vector
     cells += (np.bincount(graph.I, beta_w, n) + np.bincount(graph.J, beta_w, n))[
         :, None, None] * np.eye(3)
     return EnergyHessian(n, graph.I, graph.J, blocks, ca,
@@ -202,17 +195,31 @@ def rotor_gradient(graph: CellGraph, edges: RestEdges, P: np.ndarray, R: np.ndar
     out = np.zeros((n, 3))
     for e in graph.edge_blocks():
         I, J = graph.I[e], graph.J[e]
-        Ri = np.take(rows, I, axis=1)
-        q = np.take(rest, J, axis=1) - np.take(rest, I, axis=1)
+        Ri, ca = _rotated_edges(graph, e, rows, rest)
         p = np.take(positions, J, axis=1) - np.take(positions, I, axis=1)
-        out -= label_sum(_cross(graph.c[e] * rotate(Ri.T, q.T).T, p).T, I, n)
+        out -= label_sum(_cross(ca, p).T, I, n)
         if bending_weight:
-            Rj = np.take(rows, J, axis=1)
-            dots = np.einsum("km,km->m", Ri, Rj)
-            half = (bending_weight / 2.0 / np.take(graph.degree, I)) * np.where(dots < 0, -1.0, 1.0)
-            vec = half * (Ri[0] * Rj[1:] - Rj[0] * Ri[1:] + _cross(Ri[1:], Rj[1:]))
-            out += label_sum(vec.T, J, n) - label_sum(vec.T, I, n)
+            _, vector = _relative_rotors(Ri, np.take(rows, J, axis=1))
+            half = vector * (bending_weight / 2.0 / np.take(graph.degree, I))
+            out += label_sum(half.T, J, n) - label_sum(half.T, I, n)
     return out
+
+
+def _rotated_edges(graph, e, rows, rest):
+    """For the edges ``e`` (a slice): their source rotors ``R_i`` (4, k) and ``c_ij R_i q_ij
+    R_i~`` (3, k), from rotors and rest positions stored as rows (4, n), (3, n)."""
+    Ri = np.take(rows, graph.I[e], axis=1)
+    q = np.take(rest, graph.J[e], axis=1) - np.take(rest, graph.I[e], axis=1)
+    return Ri, graph.c[e] * rotate(Ri.T, q.T).T
+
+
+def _relative_rotors(Ri, Rj):
+    """``D = s R_j R_i~`` with ``s`` the sign that aligns each pair (rotors as (4, k) rows):
+    its scalar part ``|R_i.R_j|`` (k,) and vector part ``s (w_i v_j - w_j v_i + v_i x v_j)``
+    (3, k)."""
+    dots = np.einsum("km,km->m", Ri, Rj)
+    vector = Ri[0] * Rj[1:] - Rj[0] * Ri[1:] + _cross(Ri[1:], Rj[1:])
+    return np.abs(dots), vector * np.where(dots < 0, -1.0, 1.0)
 
 
 def _skew(v):
