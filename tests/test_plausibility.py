@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import yaml
 from click.testing import CliRunner
-from helpers import ROOT
+from helpers import ROOT, SHARED, needs_shared
 
 import srarap_cli
 from srarap_cli.cli import main
@@ -69,6 +69,41 @@ def test_a_motion_beyond_the_bounding_box_diagonal_warns_and_one_within_does_not
     assert len(warnings_of({"matrix": M.tolist()})) == 1
     (key,) = warnings_of({}, keyframes=[{"frame": 0}, {"frame": 4, "translate": [30, 0, 0]}])
     assert "keyframe 1" in key
+
+
+def _turn_about_y(degrees, decimals):
+    """The 4x4 matrix of a turn about y, written with ``decimals`` decimals, as files hold it."""
+    c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
+    M = np.array([[c, 0, s, 0.5], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1]])
+    return np.round(M, decimals).tolist()
+
+
+@pytest.mark.parametrize("decimals", [4, 6, 12])
+def test_a_rotation_matrix_written_with_rounded_decimals_is_a_rotation(decimals):
+    for degrees in (10, 30, -45):  # within the bounding-box diagonal: no other warning
+        assert warnings_of({"matrix": _turn_about_y(degrees, decimals)}) == []
+
+
+@pytest.mark.parametrize("diagonal, words", [
+    ([1, 1.001, 1], "scales unevenly (by 1, 1.001, 1 along x, y, z)"),
+    ([0.999, 0.999, 0.999], "scales by 0.999"),
+    ([1.01, 1.01, 1.01], "scales by 1.01"),
+])
+def test_a_stretch_a_thousandth_or_more_warns_with_the_factors_it_has(diagonal, words):
+    M = np.diag([*diagonal, 1.0]).tolist()
+    (warning,) = warnings_of({"matrix": M})
+    assert words in warning, warning
+
+
+@needs_shared
+def test_the_shared_cylinder_def_deforms_under_strict(tmp_path):
+    # its matrix is a 120-degree turn written with six decimals (-0.866025, 0.866025)
+    out = tmp_path / "out.obj"
+    r = CliRunner().invoke(main, ["deform", os.path.join(SHARED, "cylinder.off"),
+                                  os.path.join(SHARED, "cylinder.sel"), "-o", str(out),
+                                  "--strict", "--max-iter", "3", "--tol", "0"])
+    assert r.exit_code == 0 and "warning" not in r.stderr, r.stderr
+    assert out.exists()
 
 
 def run(tmp_path, handles, *extra, mesh=BAR):

@@ -65,28 +65,36 @@ def _check_angle(ctx, key, value):
                  "to say which")
 
 
+# A rotation written with six decimals (a Botsch-Sorkine .def file, printf's %f and %g) is
+# a rotation to about 1e-6 in A^T A, with four decimals to about 1e-4: a file's rounding is
+# not a stretch, and the targets it gives differ from the exact rotation's by that rounding.
+ROUNDING = 1e-4
+
+
 def not_rigid(A: np.ndarray) -> str:
     """What keeps the 3x3 matrix ``A`` from being a rotation (``"is a mirror ..."``), or ""
-    for a rotation (up to round-off).
+    for a rotation up to the rounding of a matrix written with four or more decimals.
 
     Examples
     --------
     >>> not_rigid(np.diag([1.0, 1.0, -1.0]))
     'is a mirror (determinant -1)'
-    >>> not_rigid(np.eye(3))
+    >>> not_rigid(np.round([[0.5, 0, -np.sqrt(0.75)], [0, 1, 0], [np.sqrt(0.75), 0, 0.5]], 6))
     ''
+    >>> not_rigid(np.diag([1.0, 1.001, 1.0]))
+    'scales unevenly (by 1, 1.001, 1 along x, y, z)'
     """
     det = float(np.linalg.det(A))
     if det < 0:
         return f"is a mirror (determinant {det:.3g})"
     gram = A.T @ A
     scale = max(float(np.abs(gram).max()), 1e-300)
-    if np.abs(gram - np.diag(np.diag(gram))).max() > 1e-9 * scale:
+    if np.abs(gram - np.diag(np.diag(gram))).max() > ROUNDING * scale:
         return "shears (its columns are not at right angles)"
     lengths = np.sqrt(np.diag(gram))
-    if np.ptp(lengths) > 1e-9 * lengths.max():
-        return f"scales unevenly (by {', '.join(f'{x:.3g}' for x in lengths)} along x, y, z)"
-    if abs(lengths[0] - 1) > 1e-9:
+    if np.ptp(lengths) > ROUNDING * lengths.max():
+        return f"scales unevenly (by {', '.join(f'{x:.6g}' for x in lengths)} along x, y, z)"
+    if abs(lengths[0] - 1) > ROUNDING:
         return f"scales by {lengths[0]:.6g}"
     return ""
 
