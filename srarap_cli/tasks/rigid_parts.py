@@ -7,6 +7,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from ..io.handles import Constraints
+from ..io.handles.transforms import ROUNDING
 
 
 def rigid_part_warnings(V: np.ndarray, F: np.ndarray, constraints: Constraints) -> list[str]:
@@ -70,5 +71,9 @@ def _rigidly_moved(X, Y, part, n_parts, diagonal):
     np.maximum.at(residual, part, np.linalg.norm(fitted - y, axis=1))
     moved = np.zeros(n_parts)
     np.maximum.at(moved, part, np.linalg.norm(Y - X, axis=1))
+    extent = np.zeros(n_parts)
+    np.maximum.at(extent, part, np.linalg.norm(x, axis=1))
+    # a handle file's rotation is rigid up to its decimals' rounding, which moves a vertex by
+    # about that much of its distance from the part's centre
     tol = 1e-9 * max(diagonal, 1e-300)
-    return has & (residual <= tol) & (moved > tol)
+    return has & (residual <= ROUNDING * extent + tol) & (moved > tol)
