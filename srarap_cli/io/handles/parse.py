@@ -17,6 +17,7 @@ from .keys import parse_track
 from .selectors import SELECTOR_KEYS, select
 from .transforms import (
     ACTION_KEYS,
+    ROUNDING,
     check_bounds,
     check_reach,
     describe_action,
@@ -200,7 +201,9 @@ def _merge(ctx, names, ids, tgts, V):
     first = np.concatenate([[True], all_ids[1:] != all_ids[:-1]])
     lead = np.maximum.accumulate(np.where(first, np.arange(all_ids.size), 0))
     scale = max(float(np.ptp(V, axis=0).max()), 1e-300)
-    clash = np.flatnonzero(np.linalg.norm(all_t - all_t[lead], axis=1) > 1e-9 * scale)
+    # the same motion written twice (a rotate and its matrix with six decimals) agrees only
+    # up to the decimals' rounding: the first group's target stands
+    clash = np.flatnonzero(np.linalg.norm(all_t - all_t[lead], axis=1) > ROUNDING * scale)
     if clash.size:
         k = clash[0]
         raise ctx.error(f"vertex {all_ids[k]} is in groups {names[owner[lead[k]]]!r} and "
