@@ -98,6 +98,10 @@ def test_the_shared_handle_files_are_described():
     d = json.loads(sel.stdout)
     assert {g["name"] for g in d["groups"]} == {"fixed", "handle"}
     assert d["constrained"] + d["free"] == d["vertices"]
+    # the .def's turn is written with six decimals (-0.866025): a rotation all the same
+    handle = next(g for g in d["groups"] if g["name"] == "handle")
+    assert handle["action"].startswith("rotate 120 degrees about -y"), handle
+    assert "not rigid" not in handle["action"], handle
 
 
 @pytest.mark.parametrize("name", ["bar-twist", "bar-bend", "bar-twist-animated"])

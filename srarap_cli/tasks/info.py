@@ -4,7 +4,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from ..io.handles import Constraints
-from ..io.handles.transforms import vector_text
+from ..io.handles.transforms import ROUNDING, vector_text
 from ..io.mesh import Mesh
 from ..solver.group_rotations import group_rotors
 from ..solver.mesh_checks import edge_adjacency, edge_counts, mesh_warnings
@@ -119,7 +119,9 @@ def describe_motion(rest: np.ndarray, targets: np.ndarray) -> str:
     if determined.all():
         R = to_matrix(q)
         residual = np.abs((rest - c) @ R.T + c + d - targets).max()
-        if residual > 1e-9 * max(np.ptp(rest, axis=0).max(), 1e-300):
+        # a motion written with rounded decimals is rigid to that rounding of its reach
+        reach = float(np.linalg.norm(rest - c, axis=1).max())
+        if residual > ROUNDING * reach + 1e-9 * max(np.ptp(rest, axis=0).max(), 1e-300):
             text += f" (not rigid: up to {residual:.3g} off that motion)"
     return text
 
