@@ -19,6 +19,14 @@ needs_shared = pytest.mark.skipif(
     reason="../shared/meshes (the team's mesh collection) is not beside the repository")
 
 
+def rounded_turn(axis, degrees, decimals):
+    """The (4, 4) matrix of a turn about ``axis`` through the origin, its entries rounded to
+    ``decimals`` as a handle file writes them."""
+    M = np.eye(4)
+    M[:3, :3] = to_matrix(from_axis_angle(axis, degrees))
+    return np.round(M, decimals)
+
+
 def torus(rings=24, segments=12, R=2.0, r=0.7):
     """Closed genus-1 torus around z: V (n, 3), F (f, 3), outward triangles."""
     u, v = np.meshgrid(np.arange(rings), np.arange(segments), indexing="ij")

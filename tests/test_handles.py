@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 import yaml
-from helpers import tube
+from helpers import rounded_turn, tube
 
 from srarap_cli.io.handles import load_handles
 from srarap_cli.runtime.errors import InputError
@@ -129,21 +129,15 @@ def test_invalid_handle_files_name_group_and_field(tmp_path, groups, message):
     assert message in str(info.value) and "\n" not in str(info.value)
 
 
-def _turn_about_z(degrees, decimals):
-    c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
-    M = np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
-    return np.round(M, decimals).tolist()
-
-
 def test_two_groups_giving_a_vertex_one_motion_in_rounded_decimals_agree(tmp_path):
     turn = {"box": BOX_TOP, "rotate": {"axis": [0, 0, 1], "angle_deg": 30}, "pivot": [0, 0, 0]}
     c = load(tmp_path, {"groups": {"a": turn, "b": {"box": BOX_TOP,
-                                                    "matrix": _turn_about_z(30, 6)}}})
-    exact = V[TOP] @ np.array(_turn_about_z(30, 17))[:3, :3].T
+                                                    "matrix": rounded_turn([0, 0, 1], 30, 6).tolist()}}})
+    exact = V[TOP] @ to_matrix(from_axis_angle([0, 0, 1], 30)).T
     assert np.allclose(target_of(c, TOP), exact, atol=1e-14)  # the first group's target
     with pytest.raises(InputError, match="with different targets"):
         load(tmp_path, {"groups": {"a": turn, "b": {"box": BOX_TOP,
-                                                    "matrix": _turn_about_z(30.1, 6)}}})
+                                                    "matrix": rounded_turn([0, 0, 1], 30.1, 6).tolist()}}})
 
 
 @pytest.mark.parametrize("solver, message", [

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import yaml
 from click.testing import CliRunner
-from helpers import ROOT, SHARED, needs_shared
+from helpers import ROOT, SHARED, needs_shared, rounded_turn
 
 import srarap_cli
 from srarap_cli.cli import main
@@ -71,17 +71,12 @@ def test_a_motion_beyond_the_bounding_box_diagonal_warns_and_one_within_does_not
     assert "keyframe 1" in key
 
 
-def _turn_about_y(degrees, decimals):
-    """The 4x4 matrix of a turn about y, written with ``decimals`` decimals, as files hold it."""
-    c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
-    M = np.array([[c, 0, s, 0.5], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1]])
-    return np.round(M, decimals).tolist()
-
-
 @pytest.mark.parametrize("decimals", [4, 6, 12])
 def test_a_rotation_matrix_written_with_rounded_decimals_is_a_rotation(decimals):
     for degrees in (10, 30, -45):  # within the bounding-box diagonal: no other warning
-        assert warnings_of({"matrix": _turn_about_y(degrees, decimals)}) == []
+        M = rounded_turn([0, 1, 0], degrees, decimals)
+        M[0, 3] = 0.5
+        assert warnings_of({"matrix": M.tolist()}) == []
 
 
 @pytest.mark.parametrize("diagonal, words", [

@@ -3,6 +3,7 @@ handles bend is not. Handle files give motions as rounded decimals, so "rigid" i
 rounding, not up to double precision."""
 import numpy as np
 import pytest
+from helpers import rounded_turn
 
 from srarap_cli.io.handles import Constraints
 from srarap_cli.tasks.rigid_parts import rigid_part_warnings
@@ -13,8 +14,7 @@ F = np.array([[0, 1, 2], [3, 4, 5]])
 
 
 def _turn(decimals):
-    c, s = np.cos(np.radians(40)), np.sin(np.radians(40))
-    return np.round(np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]), decimals)
+    return rounded_turn([0, 0, 1], 40, decimals)[:3, :3]
 
 
 def _warnings(targets_of_second):
