@@ -41,10 +41,13 @@ SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
               "numbers, a picture of its shape, its difference to the golden mesh and its "
               "energy curve, drawn by the workers; failures and regressions first).")
 @click.option("--junit", help="Also write JUnit XML (one test case per job) for CI systems.")
+@click.option("--threads", type=click.IntRange(min=1), metavar="N",
+              help="Threads for each job's solve, at most the CPUs divided by --workers. "
+              "[default: $SRARAP_THREADS, else the CPUs divided by --workers]")
 @click.option("-q", "--quiet", is_flag=True, help="No summary table.")
 @guarded
 def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unconverged: bool,
-          report: str | None, junit: str | None, quiet: bool) -> None:
+          report: str | None, junit: str | None, threads: int | None, quiet: bool) -> None:
     """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
 
     Exit code 0 when every job is ok or up to date, 8 when any job failed or regressed
@@ -67,7 +70,7 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
     try:
         rows, stopped = run_batch(jobs, out, workers, scheduler, keep_unconverged,
-                                  pictures=report is not None), None
+                                  pictures=report is not None, threads=threads), None
     except BatchInterrupted as exc:  # the workers are stopped: say what finished
         rows, stopped = exc.rows, exc.signal
         # the summary is what is left to do: a second Ctrl-C or SIGTERM (a CI runner's

@@ -21,6 +21,7 @@ def setting_option(setting: Setting, default: object = None) -> Callable[[F], F]
     """The Click option of one setting; its value is None unless given (the handle file and
     the defaults fill in). ``default`` replaces the shown default where a command has its own."""
     shown = setting.default if default is None else default
+    shown = setting.default_text if shown is None and setting.default_text else shown
     text = f"{setting.help} [default: {'none' if shown is None else shown}]"
     if setting.kind == "flag":
         return click.option(setting.flag, setting.name, is_flag=True, default=None,
@@ -74,7 +75,7 @@ def markdown_table() -> str:
     """The solver settings as the README's Markdown table (a test keeps the two equal)."""
     rows = ["| option | default | meaning |", "|---|---|---|"]
     for s in SETTINGS:
-        default = ("none" if s.default is None else "off" if s.kind == "flag"
+        default = (s.default_text or "none" if s.default is None else "off" if s.kind == "flag"
                    else f"`{s.default}`")
         rows.append(f"| `{s.flag}` | {default} | {s.help} |")
     return "\n".join(rows) + "\n"

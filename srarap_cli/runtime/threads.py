@@ -12,6 +12,7 @@ and its coarse level's setup and solve, which do not share data, so the results 
 bit for bit).
 """
 import contextlib
+import contextvars
 import functools
 import os
 import signal
@@ -133,11 +134,12 @@ def background(func: Callable[[], T]) -> Callable[[], T]:
     42
     """
     out: dict[str, Any] = {}
+    context = contextvars.copy_context()  # the caller's thread count (runtime.parallel)
 
     def run():
         try:
             with one_blas_thread():
-                out["value"] = func()
+                out["value"] = context.run(func)
         except BaseException as exc:  # handed to the waiting thread
             out["error"] = exc
 

@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.sparse import csgraph
 
+from ..runtime.parallel import using_threads
 from ..runtime.threads import single_threaded
 from . import api_checks
 from .drivers import DRIVERS, Monitor
@@ -107,6 +108,10 @@ class Deformer:
                  labels: ArrayLike | None = None, prepare: bool = True,
                  **options: Any) -> None:
         self.settings = with_keywords(settings, options, ("setup", "solve"), "Deformer")
+        with using_threads(self.settings.threads):
+            self._build(V, F, constrained, area, labels, prepare)
+
+    def _build(self, V, F, constrained, area, labels, prepare):
         s = self.settings
         self.V, self.F = api_checks.mesh_arrays(V, F)
         why = geometry_problem(self.V, self.F)
@@ -243,13 +248,19 @@ class Deformer:
             ``sqrt(tol)`` of the diagonal of the box around the rest mesh and the targets;
             see :mod:`srarap_cli.solver.drivers.monitor`); ``time_limit`` (seconds, stop
             not converged); ``accel`` (``anderson`` or ``none``, the driver); ``start``
-            (``harmonic`` or ``laplacian``, the first iterate without ``initial``)
+            (``harmonic`` or ``laplacian``, the first iterate without ``initial``);
+            ``threads`` (int >= 1; default ``$SRARAP_THREADS``, else the CPUs this process
+            may use: the same result at any count)
 
         Returns
         -------
         DeformResult
         """
         s = solve_settings(self.settings, settings, options, "solve")
+        with using_threads(s.threads):
+            return self._solve(s, targets, initial, callback, start, driver)
+
+    def _solve(self, s, targets, initial, callback, start, driver):
         targets = api_checks.targets(targets, len(self.constrained))
         if initial is not None:
             initial = api_checks.initial(initial, len(self.V))

@@ -10,6 +10,7 @@ the sign of a quaternion (``q`` and ``-q`` are the same rotation).
 
 import numpy as np
 
+from ..runtime.parallel import map_blocks, row_blocks
 from .operators import CellGraph
 from .quaternion import rotate
 
@@ -46,7 +47,12 @@ def membrane_from_covariance(S: np.ndarray, stretch_total: float, Rm: np.ndarray
     S : (n, 3, 3) from RestEdges.cross; stretch_total : float, RestEdges.stretch_total;
     Rm : (n, 3, 3) rotation matrices
     """
-    return float(stretch_total - 2.0 * np.einsum("nab,nab->", Rm, S))
+    parts = map_blocks(lambda rows: float(np.einsum("nab,nab->", Rm[rows], S[rows])),
+                       row_blocks(len(S)))
+    total = 0.0
+    for part in parts:  # in block order: the same sum at every thread count
+        total += part
+    return float(stretch_total - 2.0 * total)
 
 
 def accurate_enough(value: float, scale: float, tol: float) -> bool:
@@ -65,11 +71,15 @@ def bending_energy(graph: CellGraph, R: np.ndarray, alpha: float, area: float) -
     if alpha == 0:
         return 0.0
     sq = np.einsum("ij,ij->i", R, R)
-    total = 0.0
-    for e in graph.edge_blocks():
+
+    def block(e):
         I, J = graph.I[e], graph.J[e]
         dots = np.einsum("ij,ij->i", np.take(R, I, axis=0), np.take(R, J, axis=0))
         # |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b ; the min takes the sign that agrees
         dist = np.take(sq, I) + np.take(sq, J) - 2.0 * np.abs(dots)
-        total += float(np.maximum(dist, 0.0) @ (1.0 / np.take(graph.degree, I)))
+        return float(np.maximum(dist, 0.0) @ (1.0 / np.take(graph.degree, I)))
+
+    total = 0.0
+    for part in map_blocks(block, graph.edge_blocks()):  # summed in block order
+        total += part
     return float(alpha * area * total)

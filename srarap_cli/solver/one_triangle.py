@@ -31,6 +31,7 @@ from scipy.sparse import csr_matrix
 
 from ..runtime.errors import InputError
 from ..runtime.limits import address_space_left, available_memory
+from ..runtime.parallel import current_threads
 from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
 
@@ -75,15 +76,17 @@ def rslab_factor(A: csr_matrix, single: bool) -> Any:
         return None
     _USED_IN = os.getpid()
     dtype = "float32" if single else "float64"
+    # the solve's thread count: rslab's factor is the same bit for bit at any count (its
+    # documentation), and so are its solves (tests/test_threads.py checks both)
+    threads = current_threads()
     try:
         with held_c_stderr():
-            # one thread: the setup runs beside the simplification on the other core, and one
-            # thread's sums come in one order (byte-identical outputs)
             A = A.astype(np.float64, copy=False)
             if not _room_for(ANALYSIS_BYTES_PER_ENTRY * A.nnz):  # its analysis allocates too
                 return None
-            plan = rslab.analyze(A, path="ldlt", ordering="amd", threads=1, factor_dtype=dtype)
-            need = plan.memory_plan(dtype, nrhs=4, threads=1)["peak_bytes"]
+            plan = rslab.analyze(A, path="ldlt", ordering="amd", threads=threads,
+                                 factor_dtype=dtype)
+            need = plan.memory_plan(dtype, nrhs=4, threads=threads)["peak_bytes"]
             _check_memory(need, A.shape[0])
             if not _room_for(need):
                 return None

@@ -5,6 +5,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
+from ..runtime.parallel import row_blocks
 from .group_rotations import label_sum
 from .libigl import igl
 from .linalg import fill_order
@@ -61,6 +62,19 @@ class CellGraph:
         # 8 times the fill, 30 times the factor time)
         edges = sp.csr_matrix((np.ones(self.I.size), (self.I, self.J)), shape=(self.n,) * 2)
         return fill_order(edges)
+
+    @cached_property
+    def indptr(self) -> np.ndarray:
+        """``(n + 1,)`` int array: vertex ``i``'s edges are ``indptr[i]:indptr[i + 1]``."""
+        return np.concatenate([[0], np.cumsum(self.degree)])
+
+    @cached_property
+    def blocks(self) -> list[tuple[slice, slice]]:
+        """The per-iteration work's blocks for threads: (vertex range, its edges' range) pairs
+        of :func:`~srarap_cli.runtime.parallel.row_blocks`, in order."""
+        indptr = self.indptr
+        return [(rows, slice(int(indptr[rows.start]), int(indptr[rows.stop])))
+                for rows in row_blocks(self.n)]
 
     def fill_order(self, rows: np.ndarray | None = None) -> np.ndarray:
         """A fill-reducing order of the vertices ``rows`` (default all), as positions into

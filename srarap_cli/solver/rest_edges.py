@@ -3,6 +3,7 @@
 import numpy as np
 import scipy.sparse as sp
 
+from ..runtime.parallel import map_blocks, row_blocks
 from .operators import CellGraph
 from .quaternion import to_matrix
 
@@ -33,15 +34,30 @@ class RestEdges:
         c, n = graph.c, graph.n
         self.sum_cq = graph.cell_sum(c[:, None] * q)
         self.rest_scale = graph.cell_sum(c * np.einsum("ij,ij->i", q, q))
-        # S_i[a, b] = sum_j c_ij q_ij[b] (P_j - P_i)[a]: rows b * n + i, the -P_i part on the
-        # diagonal, so one sparse product gives every covariance
+        # S_i[a, b] = sum_j c_ij q_ij[b] (P_j - P_i)[a]: row i of matrix b holds c_ij q_ij[b]
+        # at j and the -P_i part on the diagonal (columns in order), so one sparse product per
+        # b gives every covariance. The three matrices share one index array, and each block
+        # of rows is a view of them: threads multiply blocks.
         rows = np.concatenate([graph.I, np.arange(n)])
         cols = np.concatenate([graph.J, np.arange(n)])
-        self._covariance = sp.vstack([
-            sp.csr_matrix((np.concatenate([c * q[:, b], -self.sum_cq[:, b]]), (rows, cols)),
-                          shape=(n, n)) for b in range(3)]).tocsr()
+        order = np.lexsort((cols, rows))
+        indices = _int32(cols[order])
+        indptr = _int32(np.concatenate([[0], np.cumsum(graph.degree + 1)]))
+        self._values = [np.concatenate([c * q[:, b], -self.sum_cq[:, b]])[order]
+                        for b in range(3)]
+        self._pattern = indices, indptr
+        self._blocks = [(rows, [self._rows(b, rows) for b in range(3)])
+                        for rows in row_blocks(n)]
         self._half: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._rest_total = float(self.rest_scale.sum())
+
+    def _rows(self, b: int, rows: slice) -> sp.csr_matrix:
+        """Rows ``rows`` of covariance matrix ``b`` (views of its values and indices)."""
+        indices, indptr = self._pattern
+        lo, hi = int(indptr[rows.start]), int(indptr[rows.stop])
+        return sp.csr_matrix((self._values[b][lo:hi], indices[lo:hi],
+                              indptr[rows.start:rows.stop + 1] - lo),
+                             shape=(rows.stop - rows.start, self.graph.n), copy=False)
 
     @property
     def q(self) -> np.ndarray:
@@ -75,18 +91,33 @@ class RestEdges:
         return self.cross(P), self.stretch(P)
 
     def cross(self, P: np.ndarray) -> np.ndarray:
-        """``S_i = sum_j c_ij p_ij q_ij^T``: (n, 3, 3), from one sparse product."""
-        # contiguous: einsums over a transposed view ran twice as slow downstream
-        return np.ascontiguousarray(
-            (self._covariance @ P).reshape(3, self.graph.n, 3).transpose(1, 2, 0))
+        """``S_i = sum_j c_ij p_ij q_ij^T``: (n, 3, 3), from sparse products by blocks of rows."""
+        P = np.asarray(P, dtype=float)
+        S = np.empty((self.graph.n, 3, 3))
+
+        def block(item):
+            rows, matrices = item
+            for b, matrix in enumerate(matrices):
+                S[rows, :, b] = matrix @ P
+
+        map_blocks(block, self._blocks)
+        return S
 
     def stretch(self, P: np.ndarray) -> np.ndarray:
         """``s_i = sum_j c_ij(|p_ij|^2 + |q_ij|^2)``: (n,)."""
         g = self.graph
+
+        def block(e):
+            I = g.I[e]
+            d = np.take(P, g.J[e], axis=0) - np.take(P, I, axis=0)
+            first = int(I[0])
+            return first, np.bincount(I - first, weights=g.c[e] * np.einsum("ij,ij->i", d, d))
+
         s = self.rest_scale.copy()
-        for e in g.edge_blocks():
-            d = np.take(P, g.J[e], axis=0) - np.take(P, g.I[e], axis=0)
-            s += g.cell_sum(g.c[e] * np.einsum("ij,ij->i", d, d), e)
+        # each block's sums added in block order: a cell whose edges two blocks share gets
+        # its two parts in the same order at every thread count
+        for first, part in map_blocks(block, [e for e in g.edge_blocks() if e.stop > e.start]):
+            s[first:first + part.size] += part
         return s
 
     def stretch_total(self, P: np.ndarray) -> float:
@@ -99,10 +130,14 @@ class RestEdges:
             half = g.I < g.J
             self._half = g.I[half], g.J[half], g.c[half]
         I, J, c = self._half
-        total = 0.0
-        for e in self.graph.edge_blocks(I.size):
+
+        def block(e):
             d = np.take(P, J[e], axis=0) - np.take(P, I[e], axis=0)
-            total += float(c[e] @ np.einsum("ij,ij->i", d, d))
+            return float(c[e] @ np.einsum("ij,ij->i", d, d))
+
+        total = 0.0
+        for part in map_blocks(block, self.graph.edge_blocks(I.size)):
+            total += part
         return 2.0 * total + self._rest_total
 
     def rotated_divergence(self, R: np.ndarray, Rm: np.ndarray | None = None) -> np.ndarray:
@@ -111,8 +146,25 @@ class RestEdges:
         ``Rm`` (rotation matrices of ``R``) may be passed when the caller has them.
         """
         Rm = to_matrix(R) if Rm is None else Rm
-        # c_ij is symmetric and q_ij = -q_ji, so the covariance operator's transpose holds
-        # -c_ij q_ij[b] at (i, b n + j) and -sum_j c_ij q_ij[b] at (i, b n + i): minus twice
-        # this operator, on the columns R_j[:, b] stacked by b (no second 0.2 GB matrix at
-        # 738k vertices, and as fast)
-        return -0.5 * (self._covariance.T @ Rm.transpose(2, 0, 1).reshape(-1, 3))
+        # c_ij is symmetric and q_ij = -q_ji: row i of the transposed covariance operator is
+        # minus row i of the covariance matrices with the diagonal's sign flipped, so the same
+        # matrices give b (no second 0.2 GB operator at 738k vertices), a block of rows each
+        columns = np.ascontiguousarray(Rm.transpose(2, 0, 1))  # (3, n, 3): columns by b
+        n = self.graph.n
+        out = np.empty((n, 3))
+
+        def block(item):
+            rows, matrices = item
+            acc = np.zeros((rows.stop - rows.start, 3))
+            for b, matrix in enumerate(matrices):
+                acc += matrix @ columns[b]
+                acc += (2.0 * self.sum_cq[rows, b])[:, None] * columns[b, rows]
+            out[rows] = 0.5 * acc
+
+        map_blocks(block, self._blocks)
+        return out
+
+
+def _int32(a: np.ndarray) -> np.ndarray:
+    """``a`` as 32-bit indices when they fit: scipy copies 64-bit ones on every product."""
+    return a.astype(np.int32) if a.size == 0 or a.max() < np.iinfo(np.int32).max else a

@@ -42,6 +42,8 @@ class Setting:
     choices : tuple of str, for ``choice``
     method : str, optional; the local step the setting belongs to (it is ignored by others)
     metavar : str, optional, shown in ``--help``
+    default_text : str, optional, what ``--help`` and the README say of a default that
+        depends on the machine (``threads``)
     """
 
     name: str
@@ -54,6 +56,7 @@ class Setting:
     choices: tuple = ()
     method: str | None = None
     metavar: str | None = None
+    default_text: str | None = None
 
     @property
     def flag(self) -> str:
@@ -126,6 +129,10 @@ SETTINGS = (
     Setting("start", "choice", "harmonic",
             "First iterate: the handles' rotations spread harmonically (harmonic) or identity "
             "rotors (laplacian editing).", "solve", choices=("harmonic", "laplacian")),
+    Setting("threads", "int", None,
+            "Threads for one solve; any count gives byte-identical results (batch divides "
+            "the CPUs among its workers).", "solve", minimum=1, metavar="N",
+            default_text="$SRARAP_THREADS, else the CPUs this process may use"),
     Setting("multires", "size", "auto",
             "Solve on a simplified mesh of N vertices (or P% of them, or a fraction like 0.02) "
             "and carry the result to "
@@ -177,6 +184,7 @@ class Settings:
     time_limit: float | None
     accel: str
     start: str
+    threads: int | None
     multires: int | float | str
     multires_mode: str
     strict: bool

@@ -27,6 +27,7 @@ from ..runtime.errors import InputError, excerpt
 from ..solver.quaternion import align_hemisphere, multiply, normalize
 from ..solver.result import DeformResult
 from ..solver.settings import Settings
+from .job_record import deciding
 from .pipeline import command_solver, problem, scatter
 
 FRAME_FIELDS = ("frame", "iterations", "membrane", "bending", "total", "converged",
@@ -162,7 +163,7 @@ def fingerprint(mesh: Mesh, paths: Sequence[str], opts: Settings, *extra: Any) -
         h.update(np.ascontiguousarray(array).tobytes())
     for path in paths:
         h.update(hashlib.sha256(read_input_bytes(path)).digest())
-    h.update(json.dumps([opts.as_dict(), *extra], sort_keys=True).encode())
+    h.update(json.dumps([deciding(opts.as_dict()), *extra], sort_keys=True).encode())
     return h.hexdigest()
 
 

@@ -29,9 +29,19 @@ def fingerprint(mesh: str, handles: str, settings: Mapping[str, Any], output: st
             h.update(hashlib.sha256(read_input_bytes(path)).digest())
         except InputError:
             h.update(b"missing:" + path.encode("utf-8", "surrogateescape"))
-    h.update(json.dumps([dict(settings), output, metadata.version("srarap-cli")],
+    h.update(json.dumps([deciding(settings), output, metadata.version("srarap-cli")],
                         sort_keys=True).encode())
     return h.hexdigest()
+
+
+#: settings that do not change what a job writes: the thread count (byte-identical outputs)
+NOT_DECIDING = ("threads",)
+
+
+def deciding(settings: Mapping[str, Any]) -> dict[str, Any]:
+    """``settings`` less those that do not change the outputs (:data:`NOT_DECIDING`): what
+    a fingerprint hashes, so that a rerun with another thread count is up to date."""
+    return {k: v for k, v in settings.items() if k not in NOT_DECIDING}
 
 
 def read_record(sidecar: str, key: str) -> dict[str, Any] | None:

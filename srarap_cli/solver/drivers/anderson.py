@@ -52,6 +52,8 @@ from typing import Any
 
 import numpy as np
 
+from ...runtime import parallel
+from ...runtime.parallel import by_rows, map_blocks, row_blocks
 from ..quaternion import align_hemisphere, normalize
 from ..state import State
 from ..step import LocalGlobalStep
@@ -120,8 +122,13 @@ class AndersonMixer:
         # the columns are unit vectors: a relative ridge keeps near-dependent ones solvable
         gram[np.diag_indices(k)] += 1e-10
         theta = np.linalg.solve(gram, _products(self._dF[:k], f))
-        # einsum sums in double without a double copy of the history
-        return g - np.einsum("i,ij->j", theta, self._dG[:k], dtype=float)
+        dG, out = self._dG[:k], np.empty_like(g)
+
+        def block(cols):  # einsum sums in double without a double copy of the history
+            out[cols] = g[cols] - np.einsum("i,ij->j", theta, dG[:, cols], dtype=float)
+
+        map_blocks(block, row_blocks(g.size, _flat_block()))
+        return out
 
     def _push(self, df, dg):
         scale = np.linalg.norm(df)
@@ -133,7 +140,8 @@ class AndersonMixer:
             self._gram = np.empty((self.depth, self.depth))
         assert self._dG is not None and self._gram is not None  # allocated with _dF
         i = self._next
-        self._dF[i], self._dG[i] = df / scale, dg / scale
+        by_rows(lambda part: part / scale, self._dF[i], df, size=_flat_block())
+        by_rows(lambda part: part / scale, self._dG[i], dg, size=_flat_block())
         self._count = min(self._count + 1, self.depth)
         row = _products(self._dF[:self._count], self._dF[i])
         self._gram[i, :self._count] = row
@@ -141,9 +149,20 @@ class AndersonMixer:
         self._next = (i + 1) % self.depth
 
 
+def _flat_block():
+    """Entries per block of flattened rotors (4 a vertex) that threads share."""
+    return 4 * parallel.BLOCK_ROWS
+
+
 def _products(rows, v):
-    """``rows @ v`` summed in double precision, whatever the storage of ``rows``."""
-    return np.einsum("ij,j->i", rows, v, dtype=float)
+    """``rows @ v`` summed in double precision, whatever the storage of ``rows``: by blocks
+    of columns, their partial sums added in block order (the same at any thread count)."""
+    parts = map_blocks(lambda cols: np.einsum("ij,j->i", rows[:, cols], v[cols], dtype=float),
+                       row_blocks(v.size, _flat_block()))
+    total = np.zeros(rows.shape[0])
+    for part in parts:
+        total += part
+    return total
 
 
 def anderson_iteration(step: LocalGlobalStep, state: State, monitor: Monitor,

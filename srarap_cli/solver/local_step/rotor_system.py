@@ -33,6 +33,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse import csr_matrix
 
+from ...runtime.parallel import by_rows, map_blocks, row_blocks
 from ..linalg import factor
 from ..quaternion import normalize
 from ..rest_edges import RestEdges
@@ -68,6 +69,7 @@ class RotorSystem:
         self._fixed_rows = W[self.fixed]
         self._free_to_fixed = W[self.free][:, self.fixed].tocsr()
         self._coupling = _int32(W[self.free][:, self.free].tocsr())
+        self._coupling_blocks = row_views(self._coupling)
         self._order = partial(graph.fill_order, self.free)
         self._rest_diagonal = tau[self.free] + sigma[self.free] * edges.rest_scale[self.free]
         self._powers = np.zeros(self.free.size, dtype=np.int8)
@@ -89,19 +91,29 @@ class RotorSystem:
 
     def diagonal_blocks(self, S: np.ndarray, s: np.ndarray) -> np.ndarray:
         """``sigma_i M_i + tau_i I`` (plus a tiny scale-relative shift): (n, 4, 4)."""
-        D = membrane_matrices(S, s)
-        size = max(float(D.max(initial=0)), -float(D.min(initial=0)))  # no |D| temporary
+        D = np.empty((len(s), 4, 4))
+
+        def membrane(rows):  # the blocks and their largest entry (no |D| temporary)
+            D[rows] = membrane_matrices(S[rows], s[rows])
+            return max(float(D[rows].max(initial=0)), -float(D[rows].min(initial=0)))
+
+        size = max(map_blocks(membrane, row_blocks(len(s))), default=0.0)
         shift = _REL_SHIFT * max(float(self.tau.max(initial=0)), size)
-        # in place: each (n, 4, 4) temporary is 94 MB at 738k vertices
-        D *= self.sigma[:, None, None]
-        D[:, _DIAG, _DIAG] += (self.tau + shift)[:, None]
+
+        def scale(rows):  # in place: each (n, 4, 4) temporary is 94 MB at 738k vertices
+            D[rows] *= self.sigma[rows, None, None]
+            D[rows, _DIAG, _DIAG] += (self.tau[rows] + shift)[:, None]
+
+        map_blocks(scale, row_blocks(len(s)))
         return D
 
     def free_system(self, D: np.ndarray, R_prev: np.ndarray, R_fixed: np.ndarray
                     ) -> tuple["FreeRotorMatrix", np.ndarray]:
         """The free rotors' matrix (a :class:`FreeRotorMatrix`) and right-hand side
         (flattened, 4 per free vertex)."""
-        A = FreeRotorMatrix(D[self.free], self._coupling)
+        free = by_rows(lambda ids: np.take(D, ids, axis=0), np.empty((self.free.size, 4, 4)),
+                       self.free)
+        A = FreeRotorMatrix(free, self._coupling, self._coupling_blocks)
         self._preconditioner(A.D)
         b = feedback_pull(self.phi[self.free], R_prev[self.free]) + self._free_to_fixed @ R_fixed
         return A, b.ravel()
@@ -151,16 +163,27 @@ class FreeRotorMatrix(spla.LinearOperator):
     ----------
     D : (nf, 4, 4) float array, diagonal blocks
     W : (nf, nf) sparse matrix, symmetric coupling weights
+    blocks : list of (rows, W's rows), optional: :func:`row_views` of ``W`` (a solver that
+        makes many matrices of one ``W`` makes them once)
     """
 
-    def __init__(self, D: np.ndarray, W: csr_matrix) -> None:
+    def __init__(self, D: np.ndarray, W: csr_matrix,
+                 blocks: list[tuple[slice, csr_matrix]] | None = None) -> None:
         super().__init__(dtype=float, shape=(4 * D.shape[0],) * 2)
-        self.D, self.W = D, W
+        self.D, self.W = D, sp.csr_matrix(W)
+        self._blocks = row_views(self.W) if blocks is None else blocks
 
     def _matvec(self, v):
         X = v.reshape(-1, 4)
-        out = np.einsum("nij,nj->ni", self.D, X)
-        out -= self.W @ X
+        out = np.empty_like(X)
+
+        def block(item):  # each block's rows whole: the same values at any thread count
+            rows, W = item
+            part = np.einsum("nij,nj->ni", self.D[rows], X[rows])
+            part -= W @ X
+            out[rows] = part
+
+        map_blocks(block, self._blocks)
         return out.ravel()
 
     def tocsr(self) -> csr_matrix:
@@ -168,6 +191,18 @@ class FreeRotorMatrix(spla.LinearOperator):
         nf = self.D.shape[0]
         blocks = sp.bsr_matrix((self.D, np.arange(nf), np.arange(nf + 1)), shape=self.shape)
         return (blocks - sp.kron(self.W, sp.identity(4))).tocsr()
+
+
+def row_views(A: csr_matrix) -> list[tuple[slice, csr_matrix]]:
+    """``A``'s :func:`~srarap_cli.runtime.parallel.row_blocks` with their rows of ``A``,
+    which share its values and indices (no copy)."""
+    out = []
+    for rows in row_blocks(A.shape[0]):
+        lo, hi = int(A.indptr[rows.start]), int(A.indptr[rows.stop])
+        out.append((rows, csr_matrix((A.data[lo:hi], A.indices[lo:hi],
+                                      A.indptr[rows.start:rows.stop + 1] - lo),
+                                     shape=(rows.stop - rows.start, A.shape[1]), copy=False)))
+    return out
 
 
 def _int32(A):

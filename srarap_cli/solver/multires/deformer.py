@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike
 
 from ...runtime import memory
 from ...runtime.errors import NumericalError
+from ...runtime.parallel import using_threads
 from ...runtime.threads import background, single_threaded
 from .. import api_checks
 from ..deformer import ACCEL_DRIVERS, Deformer, solve_settings
@@ -125,6 +126,10 @@ class MultiresDeformer:
                  **options: Any) -> None:
         self.settings = with_keywords(settings, options, ("setup", "solve", "build"),
                                       "MultiresDeformer")
+        with using_threads(self.settings.threads):
+            self._setup(V, F, constrained, labels, size, cache, area)
+
+    def _setup(self, V, F, constrained, labels, size, cache, area):
         self.mode = self.settings.multires_mode
         start, peak = time.perf_counter(), memory.start()
         self.V, self.F = api_checks.mesh_arrays(V, F)
@@ -277,6 +282,10 @@ class MultiresDeformer:
         :class:`~srarap_cli.solver.result.DeformResult` with its ``multires`` part."""
         begin = time.perf_counter()
         s = solve_settings(self.settings, settings, options, "solve")
+        with using_threads(s.threads):
+            return self._solve(s, targets, initial, callback, start, begin)
+
+    def _solve(self, s, targets, initial, callback, start, begin):
         targets = api_checks.targets(targets, len(self.constrained))
         if initial is not None:
             initial = api_checks.initial(initial, len(self.V))

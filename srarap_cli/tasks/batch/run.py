@@ -22,6 +22,7 @@ from typing import Any
 
 from ...io.handles import load_handles
 from ...io.mesh import read_mesh
+from ...runtime.parallel import ENV, at_most, available_cpus, default_threads, using_threads
 from ...runtime.signals import Terminated
 from ..job import JobResult, run_job_safely
 from .job_pictures import difference_picture, energy_picture, shape_picture
@@ -32,16 +33,18 @@ from .worker_pool import PoolStopped, run_in_processes
 
 
 def run_job(job: Job, out_dir: str, keep_unconverged: bool = False,
-            pictures: bool = False) -> JobResult:
+            pictures: bool = False, threads: int | None = None) -> JobResult:
     """Run one job of a manifest through the job runner (:func:`.job.run_job_safely`);
     never raises. With ``pictures``, the result carries the report's pictures of the job
     (see :func:`job_pictures`).
 
     A job that does not converge writes its record (the status, so a rerun reports it
     without solving again) but not its mesh, unless ``keep_unconverged``: as ``srarap
-    deform``."""
+    deform``. ``threads``: the threads its solve runs, and the most it may run (its own
+    ``threads`` setting, where smaller, stands)."""
     spec = deform_job(job, out_dir, keep_unconverged)
-    result = run_job_safely(spec)
+    with at_most(threads or available_cpus()), using_threads(threads):
+        result = run_job_safely(spec)
     if pictures:  # after the seconds: the solve's, not the drawing's
         result.pictures = job_pictures(job, spec.output, result.seen)
     return result.shipped()
@@ -81,15 +84,17 @@ def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
 
 def run_batch(jobs: list[Job],
               out_dir: str, workers: int = 1, scheduler: str | None = None, keep_unconverged: bool = False,
-              pictures: bool = False) -> list[JobResult]:
+              pictures: bool = False, threads: int | None = None) -> list[JobResult]:
     """Run jobs: on a Dask cluster at ``scheduler``, else in ``workers`` local processes
     (in this process when 1). Rows come back in manifest order. ``keep_unconverged``: see
-    :func:`run_job`.
+    :func:`run_job`. Each job's solve runs ``threads`` threads (default
+    ``$SRARAP_THREADS``, else its share of the CPUs), never more than its share, so that
+    workers times threads stays within the CPUs (:func:`job_threads`).
 
     The Dask workers must see the same files as this process (a shared file system).
     """
     run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged,
-                            pictures=pictures)
+                            pictures=pictures, threads=job_threads(workers, threads))
     unfinished = functools.partial(interrupted_row, out_dir=out_dir,
                                    keep_unconverged=keep_unconverged, since=time.time())
     if scheduler is not None:
@@ -104,6 +109,22 @@ def run_batch(jobs: list[Job],
                                    exc) from None
         return rows
     return _run_in_processes(jobs, run, workers, unfinished)
+
+
+def job_threads(workers: int, asked: int | None = None) -> int:
+    """Threads for each job of a batch of ``workers`` workers: its share of the CPUs this
+    process may use (at least 1), or less where ``asked`` (``--threads``) or
+    ``$SRARAP_THREADS`` says so.
+
+    Examples
+    --------
+    >>> job_threads(10 ** 6)
+    1
+    """
+    share = max(1, available_cpus() // max(1, workers))
+    asked = asked if asked is not None else (default_threads() if os.environ.get(ENV, "").strip()
+                                             else None)
+    return share if asked is None else max(1, min(asked, share))
 
 
 def _run_in_processes(jobs, run, workers, unfinished):

@@ -1,0 +1,288 @@
+"""Threads for one solve: how many, and an ordered map over blocks whose answers do not depend
+on that number.
+
+A solve's per-iteration work is split into blocks that the caller cuts from the mesh (vertex
+ranges of fixed size), never from the thread count, and each block's result is returned in
+block order, so that the caller combines them in one fixed order: 1, 2 or 16 threads compute
+the same floating-point operations in the same order and write the same bytes. numpy's large
+operations, scipy's sparse products and rslab's solves release the GIL, so Python threads run
+them side by side; BLAS itself stays at one thread (:mod:`.threads`).
+
+How many: :func:`using_threads` sets the count for the code inside it (a command's
+``--threads``, a manifest's ``threads``, the API's ``threads=``); where nobody set one, the
+environment's ``SRARAP_THREADS``, else the CPUs this process may use (:func:`available_cpus`:
+its CPU affinity and its cgroup's CPU quota, so that a container given 2 CPUs on a 64-core
+host runs 2 threads, not 64).
+"""
+import contextlib
+import contextvars
+import math
+import os
+import threading
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import ThreadPoolExecutor
+from typing import TYPE_CHECKING, TypeVar
+
+from .errors import InputError
+
+if TYPE_CHECKING:
+    import numpy as np
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+ENV = "SRARAP_THREADS"
+_CGROUP = "/sys/fs/cgroup"
+
+#: Rows per block of the per-iteration work (vertices, rotors): blocks are cut from the mesh,
+#: never from the thread count, so every thread count computes the same sums in the same
+#: order. 16k rows: a block's numpy calls take a millisecond or more against tens of
+#: microseconds to hand one to a thread, and a 62k-vertex coarse level still splits in four.
+BLOCK_ROWS = 1 << 14
+
+_count: contextvars.ContextVar[int | None] = contextvars.ContextVar("srarap_threads",
+                                                                   default=None)
+_ceiling: contextvars.ContextVar[int | None] = contextvars.ContextVar("srarap_thread_ceiling",
+                                                                     default=None)
+_pools: dict[int, ThreadPoolExecutor] = {}
+_pools_lock = threading.Lock()
+_inside = threading.local()
+
+
+def available_cpus(cgroup_root: str = _CGROUP, proc_cgroup: str = "/proc/self/cgroup") -> int:
+    """The CPUs this process may use: its affinity mask, capped by its cgroup's CPU quota
+    (rounded up: a quota of 1.5 CPUs runs 2 threads), at least 1.
+
+    Examples
+    --------
+    >>> available_cpus() >= 1
+    True
+    """
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # not Linux
+        cpus = os.cpu_count() or 1
+    quota = cgroup_quota(cgroup_root, proc_cgroup)
+    if quota is not None:
+        cpus = min(cpus, max(1, math.ceil(quota - 1e-9)))
+    return max(1, cpus)
+
+
+def cgroup_quota(root: str = _CGROUP, proc_cgroup: str = "/proc/self/cgroup") -> float | None:
+    """CPUs' worth of time the cgroups above this process allow (the smallest along its
+    path), or None where nothing caps it. cgroup v2 (``cpu.max``) and v1
+    (``cpu.cfs_quota_us`` over ``cpu.cfs_period_us``)."""
+    quotas = []
+    for path in _cgroup_dirs(root, proc_cgroup):
+        quotas.append(_v2_quota(path))
+        quotas.append(_v1_quota(path))
+    found = [q for q in quotas if q is not None]
+    return min(found) if found else None
+
+
+def _cgroup_dirs(root, proc_cgroup):
+    """The cgroup folders of this process and of its parents, for v2 and v1 layouts."""
+    try:
+        with open(proc_cgroup) as fh:
+            lines = fh.read().splitlines()
+    except OSError:
+        lines = []
+    relative = []
+    for line in lines:
+        parts = line.split(":", 2)
+        if len(parts) != 3:
+            continue
+        controllers, path = parts[1], parts[2]
+        if controllers == "":
+            relative.append((root, path))
+        elif "cpu" in controllers.split(","):
+            relative.append((os.path.join(root, "cpu"), path))
+            relative.append((os.path.join(root, controllers), path))
+    dirs = [root, os.path.join(root, "cpu")]
+    for base, path in relative:
+        parts = [p for p in path.split("/") if p and p != ".."]
+        dirs += [os.path.join(base, *parts[:k]) for k in range(len(parts) + 1)]
+    return list(dict.fromkeys(dirs))
+
+
+def _v2_quota(folder):
+    text = _read(os.path.join(folder, "cpu.max"))
+    if text is None:
+        return None
+    fields = text.split()
+    if len(fields) != 2 or fields[0] == "max":
+        return None
+    return _ratio(fields[0], fields[1])
+
+
+def _v1_quota(folder):
+    quota = _read(os.path.join(folder, "cpu.cfs_quota_us"))
+    period = _read(os.path.join(folder, "cpu.cfs_period_us"))
+    if quota is None or period is None:
+        return None
+    return _ratio(quota, period)
+
+
+def _ratio(quota, period):
+    try:
+        q, p = int(quota), int(period)
+    except ValueError:
+        return None
+    return q / p if q > 0 and p > 0 else None
+
+
+def _read(path):
+    try:
+        with open(path) as fh:
+            return fh.read().strip()
+    except OSError:
+        return None
+
+
+def default_threads() -> int:
+    """``$SRARAP_THREADS`` (a positive integer) where set, else :func:`available_cpus`.
+
+    Raises InputError (exit 4) naming the variable for any other value."""
+    text = os.environ.get(ENV, "").strip()
+    if not text:
+        return available_cpus()
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise InputError(f"{ENV}={os.environ[ENV]!r}: expected a positive whole number of "
+                         "threads")
+    return value
+
+
+def current_threads() -> int:
+    """The thread count of the code running now (see the module's docstring), within any
+    :func:`at_most` around it."""
+    count = _count.get()
+    count = default_threads() if count is None else count
+    ceiling = _ceiling.get()
+    return count if ceiling is None else min(count, ceiling)
+
+
+@contextlib.contextmanager
+def at_most(ceiling: int) -> Iterator[None]:
+    """Inside the block, no solve runs more than ``ceiling`` threads, whatever it asks for
+    (a batch's share of the CPUs per worker).
+
+    Examples
+    --------
+    >>> with at_most(2), using_threads(8):
+    ...     current_threads()
+    2
+    """
+    token = _ceiling.set(max(1, ceiling))
+    try:
+        yield
+    finally:
+        _ceiling.reset(token)
+
+
+@contextlib.contextmanager
+def using_threads(count: int | None) -> Iterator[int]:
+    """Inside the block, solves run ``count`` threads (None: the default); yields the count.
+
+    Examples
+    --------
+    >>> with using_threads(3) as n:
+    ...     n, current_threads()
+    (3, 3)
+    """
+    if count is not None and (isinstance(count, bool) or not isinstance(count, int)
+                              or count < 1):
+        raise ValueError(f"threads must be a positive integer, not {count!r}")
+    token = _count.set(count if count is not None else _count.get())
+    resolved = current_threads()
+    try:
+        yield resolved
+    finally:
+        _count.reset(token)
+
+
+def row_blocks(n: int, size: int | None = None) -> list[slice]:
+    """Consecutive ranges of at most ``size`` rows (default :data:`BLOCK_ROWS`) covering
+    ``range(n)`` (none for 0).
+
+    Examples
+    --------
+    >>> row_blocks(5, 2)
+    [slice(0, 2, None), slice(2, 4, None), slice(4, 5, None)]
+    """
+    size = size or BLOCK_ROWS
+    return [slice(a, min(a + size, n)) for a in range(0, n, size)]
+
+
+def splits(n: int) -> bool:
+    """Whether ``n`` rows make more than one block (else the caller's plain code runs)."""
+    return n > BLOCK_ROWS
+
+
+def map_blocks(func: Callable[[T], R], blocks: Iterable[T]) -> list[R]:
+    """``[func(b) for b in blocks]``, run on the current thread count; the results in block
+    order, whatever order the blocks finished in. One thread, one block, or a call from
+    inside a block (no nested pools: they could wait on each other) runs them in turn here.
+
+    Examples
+    --------
+    >>> with using_threads(2):
+    ...     map_blocks(lambda k: k * k, range(5))
+    [0, 1, 4, 9, 16]
+    """
+    items = list(blocks)
+    count = current_threads()
+    if count <= 1 or len(items) <= 1 or getattr(_inside, "busy", False):
+        return [func(item) for item in items]
+    pool = _pool(count)
+    context = contextvars.copy_context()
+    futures = [pool.submit(context.copy().run, _in_block, func, item) for item in items]
+    return [future.result() for future in futures]
+
+
+def by_rows(func: Callable[..., object], out: "np.ndarray", *arrays: "np.ndarray",
+            size: int | None = None) -> "np.ndarray":
+    """``out[r] = func(*(a[r] for a in arrays))`` for each block ``r`` of
+    :func:`row_blocks` of ``len(out)`` (``size`` rows a block), blocks side by side; returns
+    ``out``. For row-wise work, whose rows come out the same however they are cut.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> by_rows(lambda a: 2 * a, np.empty(3), np.arange(3.0))
+    array([0., 2., 4.])
+    """
+    def block(rows):
+        out[rows] = func(*(a[rows] for a in arrays))
+
+    map_blocks(block, row_blocks(len(out), size))
+    return out
+
+
+def _in_block(func, item):
+    _inside.busy = True
+    try:
+        return func(item)
+    finally:
+        _inside.busy = False
+
+
+def _pool(count):
+    with _pools_lock:
+        pool = _pools.get(count)
+        if pool is None:
+            pool = _pools[count] = ThreadPoolExecutor(count, thread_name_prefix="srarap")
+        return pool
+
+
+def _forget_pools():
+    """A forked child has none of its parent's threads: its pools start anew."""
+    global _pools_lock
+    _pools.clear()
+    _pools_lock = threading.Lock()
+
+
+os.register_at_fork(after_in_child=_forget_pools)
