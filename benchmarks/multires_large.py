@@ -17,9 +17,15 @@ same interpreter (``PYTHONPATH`` at the worktree), alternating base and HEAD per
 both see the same machine. ``--cases`` picks some (``bar500k,cylinder1m,bar2m``), ``--mesh
 M --handles H`` runs another one; ``--runs`` repeats and prints medians.
 
+``--threads 1,2`` runs the working tree at each thread count instead (alternating), and
+prints each count's whole-process and full-resolution-iteration ratios against the first,
+and whether every run wrote the same bytes (#59).
+
 Run: python benchmarks/multires_large.py [--cases bar500k,cylinder1m] [--base REV] [--runs 1]
+     [--threads 1,2]
 """
 import argparse
+import hashlib
 import json
 import os
 import re
@@ -65,11 +71,12 @@ runpy.run_module("srarap_cli", run_name="__main__", alter_sys=True)
 """
 
 
-def run_once(mesh, handles, code_root):
-    """One ``srarap deform -v`` of ``mesh`` with the package at ``code_root``."""
+def run_once(mesh, handles, code_root, extra=()):
+    """One ``srarap deform -v`` of ``mesh`` with the package at ``code_root`` (and the
+    options ``extra``)."""
     with tempfile.TemporaryDirectory() as tmp:
         cmd = [sys.executable, "-c", CHILD, code_root, "deform", "-v", mesh, handles,
-               "-o", os.path.join(tmp, "out.obj")]
+               "-o", os.path.join(tmp, "out.obj"), *extra]
         with open(os.path.join(tmp, "stderr"), "w+") as err:
             start = time.perf_counter()
             proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
@@ -77,6 +84,9 @@ def run_once(mesh, handles, code_root):
             wall = time.perf_counter() - start
             err.seek(0)
             text = err.read()
+        written = os.path.join(tmp, "out.obj")
+        digest = (hashlib.sha256(open(written, "rb").read()).hexdigest()
+                  if os.path.exists(written) else None)
     peak = usage.ru_maxrss / 1024
     stages = {k: float(v) for k, v in re.findall(r"([a-z -]+?) ([0-9.]+) s(?=[,\n]|$)",
                                                  _line(text, "srarap: multires: ") or "")}
@@ -89,7 +99,7 @@ def run_once(mesh, handles, code_root):
     return {"exit": os.waitstatus_to_exitcode(status), "wall_s": wall, "max_rss_mb": peak,
             "stages_s": {k.strip(): v for k, v in stages.items()}, "stage_peak_gb": memory,
             "peak_gb": whole, "iterations": iterations.groups() if iterations else None,
-            "summary": summary}
+            "summary": summary, "sha256": digest}
 
 
 def _line(text, marker):
@@ -128,6 +138,28 @@ def _row(label, runs):
     return "| " + " | ".join(cells) + " |"
 
 
+def _thread_ratios(results, names, counts):
+    """Each thread count against the first, same run: whole process and full-resolution
+    iterations (medians), and whether every run wrote the same bytes."""
+    print("\n| case | threads | wall ratio | full-resolution iterations ratio | same bytes |")
+    print("|---|---|---|---|---|")
+    for name in names:
+        base = results[f"{name} HEAD t{counts[0]}"]
+        digests = {r["sha256"] for n in counts for r in results[f"{name} HEAD t{n}"]}
+        for n in counts[1:]:
+            runs = results[f"{name} HEAD t{n}"]
+
+            def ratio(get, runs=runs, base=base):
+                a = [get(r) for r in runs if get(r) is not None]
+                b = [get(r) for r in base if get(r) is not None]
+                return (f"{statistics.median(a) / statistics.median(b):.3f}" if a and b
+                        else "-")
+
+            print(f"| {name} | {n} vs {counts[0]} | {ratio(lambda r: r['wall_s'])} | "
+                  f"{ratio(lambda r: r['stages_s'].get('full-resolution iterations'))} | "
+                  f"{'yes' if len(digests) == 1 else 'NO'} |")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", default="bar500k,cylinder1m,bar2m")
@@ -135,16 +167,21 @@ def main():
     ap.add_argument("--handles")
     ap.add_argument("--base", help="a git revision to measure beside the working tree")
     ap.add_argument("--runs", type=int, default=1)
+    ap.add_argument("--threads", help="thread counts to run the working tree at, e.g. 1,2 "
+                    "(--threads N each; ratios against the first, outputs compared)")
     ap.add_argument("--json")
     args = ap.parse_args()
     cases = ([(os.path.basename(args.mesh), (args.mesh, args.handles))] if args.mesh
              else [(name, _mesh(name)) for name in args.cases.split(",")])
-    codes = [("HEAD", ROOT)] + ([(args.base, _worktree(args.base))] if args.base else [])
+    counts = args.threads.split(",") if args.threads else [None]
+    codes = [(f"HEAD t{n}" if n else "HEAD", ROOT, ("--threads", n) if n else ())
+             for n in counts[::-1]]
+    codes += [(args.base, _worktree(args.base), ())] if args.base else []
     results = {}
     for name, (mesh, handles) in cases:
         for _ in range(args.runs):
-            for label, root in codes[::-1]:  # base first, then the working tree
-                run = run_once(mesh, handles, root)
+            for label, root, extra in codes[::-1]:  # base first, then the working tree
+                run = run_once(mesh, handles, root, extra)
                 results.setdefault(f"{name} {label}", []).append(run)
                 print(f"{name} {label}: exit {run['exit']}, {run['wall_s']:.1f} s, "
                       f"{run['summary']}", file=sys.stderr, flush=True)
@@ -153,6 +190,8 @@ def main():
     print("|---" * (5 + len(STAGES)) + "|")
     for label, runs in results.items():
         print(_row(label, runs))
+    if len(counts) > 1:
+        _thread_ratios(results, [name for name, _ in cases], counts)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(results, fh, indent=1)

@@ -77,7 +77,7 @@ def rslab_factor(A: csr_matrix, single: bool) -> Any:
     _USED_IN = os.getpid()
     dtype = "float32" if single else "float64"
     # the solve's thread count: rslab's factor is the same bit for bit at any count (its
-    # documentation), and so are its solves (tests/test_threads.py checks both)
+    # documentation), and so are its solves (tests/test_parallel.py checks both)
     threads = current_threads()
     try:
         with held_c_stderr():

@@ -1,0 +1,218 @@
+"""Threads for one solve (runtime.parallel): how many a process may use, the ordered map over
+mesh-cut blocks, and the contract that matters: any thread count writes the same bytes."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from helpers import ROOT, ends, run_cli, tube, twist
+
+from srarap_cli.io.mesh import Mesh, write_mesh
+from srarap_cli.runtime import parallel
+from srarap_cli.runtime.errors import InputError
+from srarap_cli.runtime.parallel import at_most, map_blocks, row_blocks, using_threads
+from srarap_cli.solver import linalg, one_triangle, operators
+from srarap_cli.solver.oneshot import make_deformer
+from srarap_cli.tasks.batch.run import job_threads
+from srarap_cli.tasks.job_record import fingerprint
+
+
+def _cgroup(tmp_path, membership, files):
+    """A fake cgroup tree: ``/proc/self/cgroup`` lines and files under the root."""
+    root = tmp_path / "cg"
+    for rel, text in files.items():
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (root / rel).write_text(text)
+    proc = tmp_path / "proc-cgroup"
+    proc.write_text(membership)
+    return str(root), str(proc)
+
+
+@pytest.mark.parametrize("membership, files, cap", [
+    ("0::/job\n", {"job/cpu.max": "150000 100000\n"}, 2),  # 1.5 CPUs run 2 threads
+    ("0::/job\n", {"job/cpu.max": "max 100000\n"}, None),  # no quota
+    ("0::/a/b\n", {"a/cpu.max": "100000 100000\n", "a/b/cpu.max": "max 100000\n"}, 1),
+    ("3:cpu,cpuacct:/docker/x\n", {"cpu,cpuacct/docker/x/cpu.cfs_quota_us": "200000\n",
+                                   "cpu,cpuacct/docker/x/cpu.cfs_period_us": "100000\n"}, 2),
+    ("3:cpu,cpuacct:/docker/x\n", {"cpu,cpuacct/docker/x/cpu.cfs_quota_us": "-1\n",
+                                   "cpu,cpuacct/docker/x/cpu.cfs_period_us": "100000\n"}, None),
+    ("garbage\n", {"cpu.max": "not numbers\n"}, None),
+])
+def test_the_cpus_a_process_may_use_follow_its_cgroup_quota(tmp_path, membership, files, cap):
+    root, proc = _cgroup(tmp_path, membership, files)
+    mask = len(os.sched_getaffinity(0))
+    assert parallel.available_cpus(root, proc) == (mask if cap is None else min(mask, cap))
+
+
+def test_the_affinity_mask_bounds_the_count(tmp_path, monkeypatch):
+    root, proc = _cgroup(tmp_path, "0::/\n", {"cpu.max": "6400000 100000\n"})  # 64 CPUs
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1, 2})
+    assert parallel.available_cpus(root, proc) == 3
+
+
+def test_srarap_threads_sets_the_default_and_a_bad_value_is_named(monkeypatch):
+    monkeypatch.setenv(parallel.ENV, "3")
+    assert parallel.current_threads() == 3
+    with using_threads(None) as count:
+        assert count == 3
+    for bad in ("0", "-2", "two", "1.5"):
+        monkeypatch.setenv(parallel.ENV, bad)
+        with pytest.raises(InputError, match=parallel.ENV):
+            parallel.current_threads()
+    monkeypatch.delenv(parallel.ENV)
+    assert parallel.current_threads() == parallel.available_cpus()
+
+
+def test_a_bad_srarap_threads_is_one_line_and_exit_4(tmp_path):
+    env = {**os.environ, parallel.ENV: "many"}
+    done = subprocess.run([sys.executable, "-m", "srarap_cli", "deform",
+                           os.path.join(ROOT, "sample_meshes", "bar.obj"),
+                           os.path.join(ROOT, "configs", "bar-twist.yaml"), "-o", "o.obj"],
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 4, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "SRARAP_THREADS='many'" in done.stderr
+    assert not (tmp_path / "o.obj").exists()
+
+
+def test_threads_zero_is_a_usage_error(tmp_path):
+    ran = run_cli(["deform", os.path.join(ROOT, "sample_meshes", "bar.obj"),
+                   os.path.join(ROOT, "configs", "bar-twist.yaml"), "-o", "o.obj",
+                   "--threads", "0"], cwd=tmp_path)
+    assert ran.returncode == 2 and "--threads" in ran.stderr
+
+
+def test_blocks_come_back_in_order_whatever_order_they_finish_in():
+    import time
+
+    def slow_first(k):
+        time.sleep(0.02 if k == 0 else 0.0)
+        return k
+
+    with using_threads(3):
+        assert map_blocks(slow_first, range(7)) == list(range(7))
+    assert row_blocks(0) == [] and row_blocks(5, 2)[-1] == slice(4, 5)
+
+
+def test_a_block_that_fails_raises_in_the_caller():
+    def fail(k):
+        if k == 2:
+            raise ValueError("block 2")
+        return k
+
+    with using_threads(2), pytest.raises(ValueError, match="block 2"):
+        map_blocks(fail, range(4))
+
+
+def test_a_map_inside_a_block_runs_in_that_block():
+    with using_threads(2):  # a nested pool could wait on itself: it runs in turn instead
+        out = map_blocks(lambda k: map_blocks(lambda j: (k, j), range(3)), range(4))
+    assert out == [[(k, j) for j in range(3)] for k in range(4)]
+
+
+def test_a_ceiling_caps_what_a_solve_asks_for():
+    with at_most(2):
+        with using_threads(8):
+            assert parallel.current_threads() == 2
+        with using_threads(1):
+            assert parallel.current_threads() == 1
+
+
+def test_a_batch_divides_the_cpus_among_its_workers(monkeypatch):
+    monkeypatch.delenv(parallel.ENV, raising=False)
+    monkeypatch.setattr("srarap_cli.tasks.batch.run.available_cpus", lambda: 16)
+    assert job_threads(1) == 16 and job_threads(4) == 4 and job_threads(32) == 1
+    assert job_threads(4, asked=8) == 4 and job_threads(4, asked=2) == 2
+    monkeypatch.setenv(parallel.ENV, "3")
+    assert job_threads(2) == 3 and job_threads(8) == 2
+    monkeypatch.setattr("srarap_cli.tasks.batch.run.available_cpus", lambda: 1)
+    assert job_threads(2, asked=4) == 1
+
+
+def test_the_thread_count_is_not_part_of_a_jobs_fingerprint(tmp_path):
+    mesh, handles = (os.path.join(ROOT, "sample_meshes", "bar.obj"),
+                     os.path.join(ROOT, "configs", "bar-twist.yaml"))
+    keys = {fingerprint(mesh, handles, {"tol": 1e-6, "threads": t}, "o.obj") for t in (1, 2, 7)}
+    assert len(keys) == 1
+    assert fingerprint(mesh, handles, {"tol": 1e-7}, "o.obj") not in keys
+
+
+@pytest.fixture
+def every_threshold(monkeypatch):
+    """Every size threshold of the parallel code crossed by a 2,000-vertex mesh: blocks of
+    96 rows, edge blocks of 500 edges, rslab for every symmetric matrix (its threads)."""
+    monkeypatch.setattr(parallel, "BLOCK_ROWS", 96)
+    monkeypatch.setattr(operators, "EDGE_BLOCK", 500)
+    monkeypatch.setenv(one_triangle.ENV, "rslab")
+    monkeypatch.setattr(linalg, "ONE_TRIANGLE_FROM", 0)
+
+
+def _solve(V, F, ids, T, threads, **options):
+    with using_threads(threads):
+        solver = make_deformer(V, F, ids, **options)
+        return solver.solve(T)
+
+
+@pytest.mark.parametrize("multires", ["off", 300])
+def test_one_two_and_three_threads_give_the_same_bits(every_threshold, multires):
+    length = 8.0
+    V, F = tube(length=length, rings=60, segments=32)
+    ids = ends(V, length)
+    T = twist(V, ids, length, 100)
+    T[T[:, 2] > 1] += [1.5, 0.0, -1.0]
+    runs = [_solve(V, F, ids, T, k, multires=multires, tol=1e-7) for k in (1, 2, 3)]
+    first = runs[0]
+    assert first.converged and len(V) > 20 * parallel.BLOCK_ROWS
+    if multires != "off":
+        assert first.multires is not None and first.coarse_iterations > 0
+    for other in runs[1:]:
+        assert other.positions.tobytes() == first.positions.tobytes()
+        assert other.rotors.tobytes() == first.rotors.tobytes()
+        assert [r["total"] for r in other.log] == [r["total"] for r in first.log]
+        assert [r["step"] for r in other.log] == [r["step"] for r in first.log]
+
+
+def test_rslab_factors_and_solves_the_same_bits_at_any_thread_count(monkeypatch):
+    import scipy.sparse as sp
+
+    monkeypatch.setenv(one_triangle.ENV, "rslab")
+    n = 120  # 14,400 rows: rslab's solves run on its pool from about 1M entries times columns
+    T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+    A = (sp.kron(T, sp.identity(n)) + sp.kron(sp.identity(n), T)
+         + 1e-3 * sp.identity(n * n)).tocsr()
+    B = np.random.default_rng(0).normal(size=(n * n, 4))
+    answers = {}
+    for approximate in (False, True):
+        for threads in (1, 2, 3):
+            with using_threads(threads):
+                answers[approximate, threads] = linalg.factor(A, symmetric=True,
+                                                              approximate=approximate)(B)
+        for threads in (2, 3):
+            assert answers[approximate, threads].tobytes() == answers[approximate, 1].tobytes()
+
+
+@pytest.mark.slow
+def test_the_command_writes_the_same_bytes_at_one_two_and_three_threads(tmp_path):
+    """Real thresholds, no patching: a 30k-vertex tube is above the block size, the edge
+    block and multires's threshold (two levels and corrections); rslab is asked for every
+    matrix (its pool), as CI's factorization pass does."""
+    length = 10.0
+    V, F = tube(length=length, rings=300, segments=100)
+    assert len(V) > max(2 * parallel.BLOCK_ROWS, 20_000)
+    write_mesh(str(tmp_path / "tube.obj"), Mesh.from_arrays(V, F))
+    (tmp_path / "h.yaml").write_text(
+        "groups:\n"
+        "  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
+        f"  top: {{box: {{min: [-2, -2, {length - 0.01}], max: [2, 2, {length + 0.01}]}},"
+        " rotate: {axis: [0, 0, 1], angle_deg: 90}}\n")
+    env = {**os.environ, one_triangle.ENV: "rslab"}
+    outputs = []
+    for threads in (1, 2, 3):
+        out = tmp_path / f"t{threads}.ply"
+        done = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "tube.obj",
+                               "h.yaml", "-o", out.name, "--threads", str(threads)],
+                              cwd=tmp_path, env=env, capture_output=True, text=True,
+                              timeout=600)
+        assert done.returncode == 0, done.stderr
+        outputs.append(out.read_bytes())
+    assert outputs[0] == outputs[1] == outputs[2]
