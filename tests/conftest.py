@@ -2,7 +2,11 @@
 whole suite the full count. Hypothesis tests without their own count take the profile;
 those that scale theirs read SRARAP_FUZZ_EXAMPLES / SRARAP_EDGE_EXAMPLES (set here before
 their modules are imported, in each xdist worker too). A value already in the environment
-wins."""
+wins.
+
+Under xdist each worker's solves run its share of the CPUs (``SRARAP_THREADS``), as a batch's
+workers do: two workers each running two threads on two cores contended (the suite's
+quick loop 48 -> 71 s). Tests of the threads set their own counts."""
 import os
 
 from hypothesis import settings
@@ -14,6 +18,11 @@ settings.register_profile("full", deadline=None)
 
 
 def pytest_configure(config):
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1") or 1)
+    if workers > 1:
+        from srarap_cli.runtime.parallel import available_cpus
+
+        os.environ.setdefault("SRARAP_THREADS", str(max(1, available_cpus() // workers)))
     quick = (config.getoption("markexpr", "") or "").replace(" ", "") == "notslow"
     if quick:
         for name, value in QUICK.items():

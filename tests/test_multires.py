@@ -206,6 +206,20 @@ def test_cli_multires_runs_caches_and_gives_identical_files(tmp_path):
     assert (tmp_path / "a.obj").read_bytes() == (tmp_path / "b.obj").read_bytes()
 
 
+def test_a_long_simplification_points_at_the_cache_unless_it_is_used(tmp_path, monkeypatch):
+    from srarap_cli.cli import deform
+
+    monkeypatch.setattr(deform, "SLOW_SIMPLIFY", 0.0)  # every simplification is long here
+    args = ["deform", SPOT, NOD, "--multires", "1000", "--max-iter", "2", "--keep-unconverged",
+            "-v", "-o", str(tmp_path / "a.obj")]
+    hint = "--cache DIR keeps the coarse mesh"
+    assert hint in CliRunner().invoke(main, args).output
+    cached = CliRunner().invoke(main, args + ["--cache", str(tmp_path / "c")])
+    assert "srarap: multires: " in cached.output and hint not in cached.output
+    quiet = CliRunner().invoke(main, args[:-3] + ["-o", str(tmp_path / "b.obj")])
+    assert hint not in quiet.output  # -v only: the default output stays one summary line
+
+
 def test_cli_rejects_a_bad_multires_value_in_options_and_in_the_handle_file(tmp_path):
     runner = CliRunner()
     out = runner.invoke(main, ["deform", SPOT, NOD, "--multires", "2", "-o",

@@ -91,7 +91,8 @@ def test_blocks_come_back_in_order_whatever_order_they_finish_in():
 
     with using_threads(3):
         assert map_blocks(slow_first, range(7)) == list(range(7))
-    assert row_blocks(0) == [] and row_blocks(5, 2)[-1] == slice(4, 5)
+    assert row_blocks(0) == [] and row_blocks(5, 2) == [slice(0, 1), slice(1, 3), slice(3, 5)]
+    assert [b.stop - b.start for b in row_blocks(19_200, 16_384)] == [9_600, 9_600]
 
 
 def test_a_block_that_fails_raises_in_the_caller():

@@ -156,3 +156,49 @@ def test_plot_of_a_log_that_reaches_zero_energy_draws_it_without_warnings(tmp_pa
     picture = imread(str(tmp_path / "e.png"))[..., :3]
     # the line across both panels (about 1,200 pixels; a log axis kept about 530 of them)
     assert (np.abs(picture - [0.12, 0.47, 0.71]).max(axis=-1) < 0.05).sum() > 900
+
+
+def _dense_tube(rings=200, segments=100):
+    m = tube_mesh(length=6.0, rings=rings, segments=segments)
+    return m.vertices, m.triangles()[0]
+
+
+def test_a_mesh_larger_than_its_pixels_is_drawn_reduced_with_its_colours():
+    from srarap_cli.tasks.render import display_mesh
+
+    V, F = _dense_tube()
+    top = V[F].mean(axis=1)[:, 2] > 3.0
+    colors = np.where(top[:, None], PALETTE[1], PALETTE[0])  # blue top half, red bottom
+    W, G, c = display_mesh(V, F, colors, 5_000)
+    assert len(G) <= 2 * 5_000 < len(F) and G.max() < len(W)
+    assert (W.min(axis=0) >= V.min(axis=0) - 1e-12).all()
+    assert (W.max(axis=0) <= V.max(axis=0) + 1e-12).all()
+    centre = W[G].mean(axis=1)[:, 2]
+    # each face's colour is the mean of those it stands for: pure away from the seam
+    assert np.allclose(c[centre > 3.5], PALETTE[1]) and np.allclose(c[centre < 2.5], PALETTE[0])
+    assert display_mesh(V, F, colors, len(F))[1] is F  # within the budget: untouched
+
+
+def test_the_reduced_picture_looks_like_the_full_one(tmp_path, monkeypatch):
+    """What the eye compares: the same silhouette and shading, pixel by pixel, with and
+    without the reduction; and matplotlib gets no more faces than the pixels can show."""
+    from srarap_cli.tasks import render
+
+    V, F = _dense_tube(rings=240, segments=120)
+    colors = render.face_colors(F, [np.flatnonzero(V[:, 2] < 0.5)])
+    drawn = []
+    real = render.draw
+    monkeypatch.setattr(render, "draw", lambda ax, V, F, *a: drawn.append(len(F)) or
+                        real(ax, V, F, *a))
+    size = (240, 240)
+    reduced = render.render_png([[(V, F, colors, 1.0)]], size, "iso")
+    assert drawn and max(drawn) <= 2 * render.FACES_PER_PIXEL * size[0] * size[1] < len(F)
+    monkeypatch.setattr(render, "FACES_PER_PIXEL", 10.0)
+    full = render.render_png([[(V, F, colors, 1.0)]], size, "iso")
+    assert drawn[-1] == len(F)
+    (tmp_path / "reduced.png").write_bytes(reduced)
+    (tmp_path / "full.png").write_bytes(full)
+    a, b = imread(str(tmp_path / "reduced.png"))[..., :3], imread(str(tmp_path / "full.png"))[..., :3]
+    shape_a, shape_b = a.min(axis=-1) < 0.99, b.min(axis=-1) < 0.99
+    assert (shape_a != shape_b).mean() < 0.01  # the silhouettes agree but for a few pixels
+    assert np.abs(a - b)[shape_a & shape_b].mean() < 0.03  # and the shading inside them

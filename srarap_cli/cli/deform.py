@@ -76,12 +76,27 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
         progress.close()
     measured = memory.gigabytes(done.peaks)
     report(verbosity, warnings=done.warnings,
-           details=done.solve.report_lines() + ([f"srarap: peak memory: {measured}"]
-                                                if measured else []),
+           details=done.solve.report_lines() + _cache_hint(done.solve, cache)
+           + ([f"srarap: peak memory: {measured}"] if measured else []),
            summary=_summary(done.solve, done.settings,
                             done.written and ("<stdout>" if out == "-" else out)))
     if done.status is JobStatus.NOT_CONVERGED:
         raise SystemExit(exit_codes.NOT_CONVERGED)
+
+
+#: seconds of simplification from which ``-v`` says that ``--cache`` would skip it
+SLOW_SIMPLIFY = 10.0
+
+
+def _cache_hint(result, cache):
+    """The ``-v`` line that points a user of a large mesh at ``--cache`` (the simplification
+    is the longest stage that runs on one core)."""
+    part = result.multires
+    seconds = part.stages.get("simplify", 0.0) if part is not None else 0.0
+    if cache is not None or part is None or part.cache_hit or seconds < SLOW_SIMPLIFY:
+        return []
+    return [f"srarap: multires: the simplification took {seconds:.1f} s; --cache DIR keeps "
+            "the coarse mesh, and a rerun of this mesh skips it"]
 
 
 def _summary(result, opts, out):

@@ -1,15 +1,14 @@
-"""One BLAS thread for srarap's numerical work.
+"""One BLAS thread for srarap's numerical work, and the worker processes of a batch.
 
 The results must not depend on the machine's thread settings: OpenBLAS splits dot products
 and matrix products by thread count, which changed the last digits of a solve (4,125 of
-4,802 lines of a cylinder's output differed between 1 and 2 threads). The threads bought
-nothing either: the work here is sparse (SuperLU, Eigen, scipy's sparse products are single
-threaded) and the dense BLAS calls are small, so a second thread only added CPU time, and
-under load (``batch --workers 2`` on 2 cores) it slowed everything down. Parallelism comes from
-running jobs side by side (``batch --workers``), and from one overlap of independent stages
-(:func:`background`: a multiresolution solve's full-resolution setup beside its simplification
-and its coarse level's setup and solve, which do not share data, so the results stay the same
-bit for bit).
+4,802 lines of a cylinder's output differed between 1 and 2 threads). BLAS threads would buy
+little either: the dense BLAS calls are small. A solve's own threads (:mod:`.parallel`) split
+its work into blocks cut from the mesh, never from the thread count, so any count gives the
+same bytes; jobs run side by side in processes (``batch --workers``), each with its share of
+the CPUs; and one overlap of independent stages (:func:`background`: a multiresolution
+solve's full-resolution setup beside its simplification and its coarse level's setup and
+solve, which do not share data) keeps the results the same bit for bit.
 """
 import contextlib
 import contextvars

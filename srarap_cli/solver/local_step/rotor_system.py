@@ -37,6 +37,7 @@ from ...runtime.parallel import by_rows, map_blocks, row_blocks
 from ..linalg import factor
 from ..quaternion import normalize
 from ..rest_edges import RestEdges
+from .block_cg import conjugate_gradients
 from .constrained_rotors import constrained_rotors
 from .feedback import feedback_pull
 from .membrane import membrane_matrices
@@ -137,15 +138,15 @@ class RotorSystem:
     def _solve(self, A, b, x0, forcing):
         solve = self._precondition
         assert solve is not None  # there are free rotors to solve for
-        # with its dtype given, LinearOperator does not try a preconditioner solve to guess it
-        precond = spla.LinearOperator(
-            A.shape, matvec=lambda v: solve(v.reshape(-1, 4)).ravel(),
-            dtype=float)
         # CG for the correction from x0, whose right-hand side is x0's residual: relative to
         # it, the forcing is CG's own rtol, and CG needs no second product for its residual
-        correction, info = spla.cg(A, b - A @ x0, rtol=forcing,
-                                   atol=CG_RTOL * float(np.linalg.norm(b)), M=precond,
-                                   maxiter=CG_MAXITER)
+        residual = np.empty_like(b)
+        A.product(x0, residual)
+        residual -= b
+        residual *= -1.0
+        correction, info = conjugate_gradients(
+            A.product, lambda r: solve(r.reshape(-1, 4)).ravel(), residual, rtol=forcing,
+            atol=CG_RTOL * float(np.linalg.norm(b)), maxiter=CG_MAXITER)
         if info != 0:
             return factor(A.tocsr(), symmetric=True)(b)
         return x0 + correction
@@ -174,17 +175,27 @@ class FreeRotorMatrix(spla.LinearOperator):
         self._blocks = row_views(self.W) if blocks is None else blocks
 
     def _matvec(self, v):
-        X = v.reshape(-1, 4)
-        out = np.empty_like(X)
+        out = np.empty(v.shape[0])
+        self.product(np.ascontiguousarray(v, dtype=float).ravel(), out)
+        return out
+
+    def product(self, p: np.ndarray, q: np.ndarray) -> float:
+        """``q = A p`` (flat (4 nf,) arrays) by blocks of rows; returns ``p . q`` (per-block
+        sums added in block order): conjugate gradients' product and the dot it feeds, in
+        one pass."""
+        X, out = p.reshape(-1, 4), q.reshape(-1, 4)
 
         def block(item):  # each block's rows whole: the same values at any thread count
             rows, W = item
             part = np.einsum("nij,nj->ni", self.D[rows], X[rows])
             part -= W @ X
             out[rows] = part
+            return float(np.einsum("ij,ij->", X[rows], part))
 
-        map_blocks(block, self._blocks)
-        return out.ravel()
+        total = 0.0
+        for part in map_blocks(block, self._blocks):
+            total += part
+        return total
 
     def tocsr(self) -> csr_matrix:
         """The assembled sparse matrix (for the direct fallback)."""

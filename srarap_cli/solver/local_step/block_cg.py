@@ -1,0 +1,99 @@
+"""Preconditioned conjugate gradients whose vector work runs in blocks on the solve's threads.
+
+SciPy's ``cg`` runs each vector operation of an iteration as one numpy call on one core: on
+the 1.2M-vertex cylinder's rotor system (4.8M unknowns) about fifteen passes over 38 MB
+vectors an iteration, a tenth of an iteration's time beside the sparse product and the
+preconditioner. Here the same iteration (same recurrences, same stopping test) fuses them
+into five passes by blocks of the vector, side by side on the threads of
+:mod:`~srarap_cli.runtime.parallel`; each dot product is a sum of per-block partial sums
+added in block order, so the iterates are the same bit for bit at any thread count.
+"""
+from collections.abc import Callable
+
+import numpy as np
+
+from ...runtime import parallel
+from ...runtime.parallel import map_blocks, row_blocks
+
+
+def conjugate_gradients(product: Callable[[np.ndarray, np.ndarray], float],
+                        precondition: Callable[[np.ndarray], np.ndarray], b: np.ndarray,
+                        rtol: float, atol: float, maxiter: int) -> tuple[np.ndarray, int]:
+    """Solve ``A x = b`` from ``x = 0`` for a symmetric positive definite ``A``.
+
+    Parameters
+    ----------
+    product : callable ``(p, q) -> p . (A p)``, writing ``A p`` into ``q`` (both (m,) float
+        arrays): the matrix's product fused with the dot product it feeds
+    precondition : callable, ``r -> M^-1 r`` ((m,) float arrays)
+    b : (m,) float array
+    rtol, atol : float, stop once ``|r| < max(atol, rtol |b|)`` (SciPy's ``cg`` test)
+    maxiter : int, iterations at most
+
+    Returns
+    -------
+    x : (m,) float array
+    info : int, 0 when converged, else ``maxiter`` (as SciPy's ``cg``)
+
+    Examples
+    --------
+    >>> A = np.array([[4.0, 1.0], [1.0, 3.0]])
+    >>> def product(p, q):
+    ...     q[:] = A @ p
+    ...     return float(p @ q)
+    >>> x, info = conjugate_gradients(product, lambda r: r / np.diag(A), np.array([1.0, 2.0]),
+    ...                               1e-12, 0.0, 10)
+    >>> info, np.allclose(A @ x, [1.0, 2.0])
+    (0, True)
+    """
+    blocks = row_blocks(b.size, 4 * parallel.BLOCK_ROWS)
+    b_norm = np.sqrt(_dot(b, b, blocks))
+    tol = max(float(atol), float(rtol) * b_norm)
+    x = np.zeros_like(b)
+    if b_norm == 0.0:
+        return x, 0
+    r, p, q = b.copy(), np.empty_like(b), np.empty_like(b)
+    rr, rho_prev = b_norm * b_norm, 0.0
+    for iteration in range(maxiter):
+        if np.sqrt(rr) < tol:
+            return x, 0
+        z = precondition(r)
+        rho = _dot(r, z, blocks)
+        _update(p, z, rho / rho_prev if iteration else None, blocks)
+        alpha = rho / product(p, q)
+        rr = _step(x, r, p, q, alpha, blocks)
+        rho_prev = rho
+    return x, maxiter
+
+
+def _dot(a, b, blocks):
+    """``a . b`` as per-block sums added in block order."""
+    total = 0.0
+    for part in map_blocks(lambda s: float(a[s] @ b[s]), blocks):
+        total += part
+    return total
+
+
+def _update(p, z, beta, blocks):
+    """``p = z + beta p``; ``p = z`` for ``beta`` None (the first iteration)."""
+    def block(s):
+        if beta is not None:
+            p[s] *= beta
+            p[s] += z[s]
+        else:
+            p[s] = z[s]
+
+    map_blocks(block, blocks)
+
+
+def _step(x, r, p, q, alpha, blocks):
+    """``x += alpha p``, ``r -= alpha q`` in one pass; returns ``r . r``."""
+    def block(s):
+        x[s] += alpha * p[s]
+        r[s] -= alpha * q[s]
+        return float(r[s] @ r[s])
+
+    total = 0.0
+    for part in map_blocks(block, blocks):
+        total += part
+    return total
