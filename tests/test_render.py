@@ -169,13 +169,17 @@ def test_a_mesh_larger_than_its_pixels_is_drawn_reduced_with_its_colours():
     V, F = _dense_tube()
     top = V[F].mean(axis=1)[:, 2] > 3.0
     colors = np.where(top[:, None], PALETTE[1], PALETTE[0])  # blue top half, red bottom
-    W, G, c = display_mesh(V, F, colors, 5_000)
+    W, G, c, normals = display_mesh(V, F, colors, 5_000)
     assert len(G) <= 2 * 5_000 < len(F) and G.max() < len(W)
     assert (W.min(axis=0) >= V.min(axis=0) - 1e-12).all()
     assert (W.max(axis=0) <= V.max(axis=0) + 1e-12).all()
     centre = W[G].mean(axis=1)[:, 2]
     # each face's colour is the mean of those it stands for: pure away from the seam
     assert np.allclose(c[centre > 3.5], PALETTE[1]) and np.allclose(c[centre < 2.5], PALETTE[0])
+    # the summed normals of the faces each stands for point out of the tube, as its own
+    radial = W[G].mean(axis=1)[:, :2]
+    side = (centre > 0.5) & (centre < 5.5)
+    assert (np.einsum("ij,ij->i", normals[side, :2], radial[side]) > 0).mean() > 0.99
     assert display_mesh(V, F, colors, len(F))[1] is F  # within the budget: untouched
 
 

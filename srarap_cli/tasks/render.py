@@ -34,9 +34,13 @@ def camera(view: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return d, np.cross(right, d), right
 
 
-def face_shading(V: np.ndarray, F: np.ndarray, d: np.ndarray) -> np.ndarray:
-    """Two-sided Lambert intensity per face, light from the viewer's upper left."""
-    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+def face_shading(V: np.ndarray, F: np.ndarray, d: np.ndarray,
+                 normals: np.ndarray | None = None) -> np.ndarray:
+    """Two-sided Lambert intensity per face, light from the viewer's upper left; ``normals``
+    (f, 3), any length, replace the faces' own (a display mesh's: those of the faces each
+    stands for)."""
+    n = (np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]) if normals is None
+         else np.array(normals, dtype=float))
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
     light = -d + 0.3 * np.cross(d, [0.0, 0, 1]) if abs(d[2]) < 0.99 else -d
     light /= np.linalg.norm(light)
@@ -44,15 +48,24 @@ def face_shading(V: np.ndarray, F: np.ndarray, d: np.ndarray) -> np.ndarray:
 
 
 def draw(ax: Any, V: np.ndarray, F: np.ndarray, colors: np.ndarray, view: str,
-         alpha: float = 1.0) -> tuple[float, float, float, float]:
-    """Draw one mesh on matplotlib axes ``ax``; returns its 2D bounding box (x0, x1, y0, y1)."""
+         alpha: float = 1.0, normals: np.ndarray | None = None
+         ) -> tuple[float, float, float, float]:
+    """Draw one mesh on matplotlib axes ``ax``; returns its 2D bounding box (x0, x1, y0, y1).
+
+    A display mesh (``normals`` given, see :func:`display_mesh`) shaded by the normals of
+    the faces it stands for and, when translucent, drawn opaque in its colour blended with
+    the white page: its clustered faces overlap along the cells' seams, and translucent
+    overlaps drew the grid of the cells."""
     from matplotlib.collections import PolyCollection
     d, up, right = camera(view)
     xy = np.column_stack([V @ right, V @ up])
     depth = (V @ d)[F].mean(axis=1)
     order = np.argsort(-depth, kind="stable")  # farthest first
-    shade = face_shading(V, F, d)[:, None]
-    rgba = np.column_stack([np.clip(colors * shade, 0, 1), np.full(len(F), alpha)])
+    shade = face_shading(V, F, d, normals)[:, None]
+    rgb = np.clip(colors * shade, 0, 1)
+    if normals is not None and alpha < 1.0:
+        rgb, alpha = alpha * rgb + (1.0 - alpha), 1.0
+    rgba = np.column_stack([rgb, np.full(len(F), alpha)])
     ax.add_collection(PolyCollection(xy[F[order]], facecolors=rgba[order], edgecolors="none",
                                      antialiaseds=False))
     return xy[:, 0].min(), xy[:, 0].max(), xy[:, 1].min(), xy[:, 1].max()
@@ -66,12 +79,13 @@ FACES_PER_PIXEL = 0.25
 
 
 def display_mesh(V: np.ndarray, F: np.ndarray, colors: np.ndarray, budget: int
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """A mesh of about ``budget`` faces or fewer that looks like ``(V, F)`` at the size of a
     picture: vertices clustered on a grid whose cells hold about two faces' worth of the
     surface, each cluster at its vertices' mean, faces between three clusters kept once,
-    each with the mean colour of the faces it stands for. ``(V, F, colors)`` themselves
-    when ``F`` has no more than ``budget`` faces.
+    each with the mean colour and the summed normal of the faces it stands for (its shading:
+    a clustered face can fold against its neighbours). ``(V, F, colors, None)`` when ``F``
+    has no more than ``budget`` faces.
 
     Parameters
     ----------
@@ -80,36 +94,43 @@ def display_mesh(V: np.ndarray, F: np.ndarray, colors: np.ndarray, budget: int
 
     Returns
     -------
-    V : (m, 3) float array; F : (g, 3) int array; colors : (g, 3) float array
+    V : (m, 3) float array; F : (g, 3) int array; colors : (g, 3) float array;
+    normals : (g, 3) float array (area-weighted), or None for the mesh itself
 
     Examples
     --------
     >>> import igl
     >>> from srarap_cli.solver.multires.simplify import _octahedron
     >>> V, F = igl.loop(*igl.loop(*igl.loop(*_octahedron())))
-    >>> W, G, c = display_mesh(V, F, np.ones((len(F), 3)), 100)
-    >>> len(F), 0 < len(G) <= 2 * 100, c.shape[1]
-    (512, True, 3)
+    >>> W, G, c, normals = display_mesh(V, F, np.ones((len(F), 3)), 100)
+    >>> len(F), 0 < len(G) <= 2 * 100, c.shape[1], normals.shape == G.shape
+    (512, True, 3, True)
     """
     if len(F) <= budget:
-        return V, F, colors
+        return V, F, colors, None
     a, b, c = (np.take(V, F[:, k], axis=0) for k in range(3))
-    area = 0.5 * float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+    normals = np.cross(b - a, c - a)
+    area = 0.5 * float(np.linalg.norm(normals, axis=1).sum())
     lo = V.min(axis=0)
     cell = max(np.sqrt(2.0 * area / max(budget, 1)), 1e-12 * float(np.ptp(V, axis=0).max()),
                1e-300)
     cells = np.floor((V - lo) / cell).astype(np.int64)
     span = cells.max(axis=0) + 1
-    _, label = np.unique((cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2],
-                         return_inverse=True)
-    label = label.ravel()
+    key = (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]
+    grid = int(np.prod(span))
+    if grid <= 8 * len(V):  # the cells' numbers by a pass over the grid, not a sort
+        used = np.zeros(grid, dtype=bool)
+        used[key] = True
+        label = (np.cumsum(used) - 1)[key]
+    else:
+        label = np.unique(key, return_inverse=True)[1].ravel()
     m = int(label.max()) + 1
     counts = np.bincount(label, minlength=m)
     W = np.column_stack([np.bincount(label, weights=V[:, k], minlength=m)
                          for k in range(3)]) / counts[:, None]
     G = label[F]
     whole = (G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 0] != G[:, 2])
-    G, colors = G[whole], np.asarray(colors, dtype=float)[whole]
+    G, colors, normals = G[whole], np.asarray(colors, dtype=float)[whole], normals[whole]
     ordered = np.sort(G, axis=1)
     if m < 1 << 21:  # one int64 key per face: several times faster than unique rows
         ordered = (ordered[:, 0] * m + ordered[:, 1]) * m + ordered[:, 2]
@@ -118,7 +139,11 @@ def display_mesh(V: np.ndarray, F: np.ndarray, colors: np.ndarray, budget: int
     size = np.bincount(which)
     mean = np.column_stack([np.bincount(which, weights=colors[:, k]) / size
                             for k in range(colors.shape[1])])
-    return W, G[first], mean
+    # a face's normal turned to agree with its representative's winding, then summed
+    G, sign = G[first], np.sign(np.einsum("ij,ij->i", normals, normals[first][which]))
+    summed = np.column_stack([np.bincount(which, weights=sign * normals[:, k])
+                              for k in range(3)])
+    return W, G, mean, summed
 
 
 def _frame(axes, boxes):
@@ -205,15 +230,16 @@ def render_png(panels: list, size: tuple[int, int] = (800, 600),
     top = 0.92 if labelled else 1.0  # room above the panels for their labels
     # every mesh once, reduced to what its panel's pixels can show
     budget = int(FACES_PER_PIXEL * size[0] * width / columns * size[1] * top)
-    panels = [[(*display_mesh(V, F, c, budget), a) for V, F, c, a in meshes]
-              for meshes in panels]
+    shown = [[(display_mesh(V, F, c, budget), a) for V, F, c, a in meshes]
+             for meshes in panels]
     for v, name in enumerate(views):
         boxes, axes = [], []
-        for k, meshes in enumerate(panels):
+        for k in range(len(panels)):
             col = v * len(panels) + k
             ax = fig.add_axes((col * width / columns, 0, width / columns, top))
             ax.set_axis_off()
-            boxes += [draw(ax, V, F, c, name, a) for V, F, c, a in meshes]
+            boxes += [draw(ax, V, F, c, name, a, normals)
+                      for (V, F, c, normals), a in shown[k]]
             axes.append(ax)
             label = ", ".join(([titles[k]] if titles else []) + ([name] if len(views) > 1
                                                                  else []))
