@@ -14,6 +14,7 @@ from srarap_cli.runtime.errors import InputError
 from srarap_cli.runtime.parallel import at_most, map_blocks, row_blocks, using_threads
 from srarap_cli.solver import linalg, one_triangle, operators
 from srarap_cli.solver.oneshot import make_deformer
+from srarap_cli.solver.operators import cell_graph
 from srarap_cli.tasks.batch.run import job_threads
 from srarap_cli.tasks.job_record import fingerprint
 
@@ -48,7 +49,9 @@ def test_the_cpus_a_process_may_use_follow_its_cgroup_quota(tmp_path, membership
 def test_the_affinity_mask_bounds_the_count(tmp_path, monkeypatch):
     root, proc = _cgroup(tmp_path, "0::/\n", {"cpu.max": "6400000 100000\n"})  # 64 CPUs
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1, 2})
+    parallel.available_cpus.cache_clear()
     assert parallel.available_cpus(root, proc) == 3
+    parallel.available_cpus.cache_clear()
 
 
 def test_srarap_threads_sets_the_default_and_a_bad_value_is_named(monkeypatch):
@@ -192,28 +195,55 @@ def test_rslab_factors_and_solves_the_same_bits_at_any_thread_count(monkeypatch)
             assert answers[approximate, threads].tobytes() == answers[approximate, 1].tobytes()
 
 
-@pytest.mark.slow
-def test_the_command_writes_the_same_bytes_at_one_two_and_three_threads(tmp_path):
-    """Real thresholds, no patching: a 30k-vertex tube is above the block size, the edge
-    block and multires's threshold (two levels and corrections); rslab is asked for every
-    matrix (its pool), as CI's factorization pass does."""
-    length = 10.0
-    V, F = tube(length=length, rings=300, segments=100)
+def _big_tube(tmp_path, length=10.0):
+    """A 50k-vertex tube (above the block size, the edge block and multires's threshold) and
+    a handle file twisting its top."""
+    V, F = tube(length=length, rings=420, segments=120)
     assert len(V) > max(2 * parallel.BLOCK_ROWS, 20_000)
+    assert cell_graph(V, F).I.size > operators.EDGE_BLOCK
     write_mesh(str(tmp_path / "tube.obj"), Mesh.from_arrays(V, F))
     (tmp_path / "h.yaml").write_text(
         "groups:\n"
         "  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
         f"  top: {{box: {{min: [-2, -2, {length - 0.01}], max: [2, 2, {length + 0.01}]}},"
         " rotate: {axis: [0, 0, 1], angle_deg: 90}}\n")
-    env = {**os.environ, one_triangle.ENV: "rslab"}
-    outputs = []
-    for threads in (1, 2, 3):
-        out = tmp_path / f"t{threads}.ply"
-        done = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", "tube.obj",
-                               "h.yaml", "-o", out.name, "--threads", str(threads)],
-                              cwd=tmp_path, env=env, capture_output=True, text=True,
-                              timeout=600)
-        assert done.returncode == 0, done.stderr
-        outputs.append(out.read_bytes())
+
+
+def _srarap(tmp_path, *args, env=None):
+    done = subprocess.run([sys.executable, "-m", "srarap_cli", *args], cwd=tmp_path,
+                          env={**os.environ, **(env or {})}, capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.slow
+def test_a_batch_of_two_workers_writes_what_deform_writes_at_any_count(tmp_path):
+    """Each worker of ``batch --workers 2`` runs its share of the CPUs (and with
+    ``--threads 3``, at most that share): the files are deform's at 1 and at 3 threads."""
+    _big_tube(tmp_path)
+    (tmp_path / "jobs.yaml").write_text(
+        "jobs:\n"
+        "  - {name: a, mesh: tube.obj, handles: h.yaml, output: a.obj}\n"
+        "  - {name: b, mesh: tube.obj, handles: h.yaml, output: b.obj,"
+        " settings: {threads: 3}}\n")
+    _srarap(tmp_path, "batch", "jobs.yaml", "-o", "res", "--workers", "2", "--threads", "3")
+    for threads in ("1", "3"):
+        _srarap(tmp_path, "deform", "tube.obj", "h.yaml", "-o", f"t{threads}.obj", "--threads",
+                threads)
+    expected = (tmp_path / "t1.obj").read_bytes()
+    assert (tmp_path / "t3.obj").read_bytes() == expected
+    assert (tmp_path / "res" / "a.obj").read_bytes() == expected
+    assert (tmp_path / "res" / "b.obj").read_bytes() == expected
+
+
+@pytest.mark.slow
+def test_the_command_writes_the_same_bytes_at_one_two_and_three_threads(tmp_path):
+    """Real thresholds, no patching: a 50k-vertex tube is above the block size, the edge
+    block and multires's threshold (two levels and corrections); rslab is asked for every
+    matrix (its pool), as CI's factorization pass does."""
+    _big_tube(tmp_path)
+    for threads in ("1", "2", "3"):
+        _srarap(tmp_path, "deform", "tube.obj", "h.yaml", "-o", f"t{threads}.ply", "--threads",
+                threads, env={one_triangle.ENV: "rslab"})
+    outputs = [(tmp_path / f"t{k}.ply").read_bytes() for k in (1, 2, 3)]
     assert outputs[0] == outputs[1] == outputs[2]

@@ -14,7 +14,7 @@ import sys
 import time
 
 import pytest
-from helpers import tube_mesh
+from helpers import ROOT, tube_mesh
 
 from srarap_cli.io.mesh import write_mesh
 
@@ -276,3 +276,26 @@ def test_a_signal_held_back_by_deferred_waits_for_the_block_also_beside_other_th
     p = subprocess.run([sys.executable, "-c", DEFERRED_PROBE.replace("{name}", name)],
                        capture_output=True, text=True, timeout=60)
     assert p.stdout.strip() == f"after the outer block {raised}", p.stdout + p.stderr
+
+
+@pytest.mark.parametrize("command", [
+    ["deform", os.path.join(ROOT, "sample_meshes", "spot.obj"),
+     os.path.join(ROOT, "configs", "spot-nod.yaml"), "-o", "-", "--format", "obj"],
+    ["deform", os.path.join(ROOT, "sample_meshes", "spot.obj"),
+     os.path.join(ROOT, "configs", "spot-nod.yaml"), "-o", "-", "--format", "ply"],
+])
+def test_a_reader_that_stops_early_is_a_broken_pipe_not_a_success(tmp_path, command):
+    """``-o - | head -c 100``: the reader takes part of a write larger than the pipe holds
+    and goes: exit 141 and no "wrote" line, every time (a buffered write returned the bytes
+    it got out, and the run exited 0 saying "wrote <stdout>")."""
+    for _ in range(3):
+        writer = subprocess.Popen([sys.executable, "-m", "srarap_cli", *command], cwd=tmp_path,
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        reader = subprocess.Popen(["head", "-c", "100"], stdin=writer.stdout,
+                                  stdout=subprocess.DEVNULL)
+        writer.stdout.close()  # the reader holds the pipe's only reading end
+        reader.wait(timeout=120)
+        err = writer.stderr.read().decode()
+        writer.wait(timeout=120)
+        assert writer.returncode == 141, err
+        assert "wrote" not in err and "Traceback" not in err

@@ -44,9 +44,18 @@ def say(text: str) -> None:
 
 def write_stdout(data: bytes) -> None:
     """``data`` (bytes) to standard output; a full device or a closed pipe is an output error
-    and a broken pipe respectively, never an internal one."""
+    and a broken pipe respectively, never an internal one.
+
+    A buffered write that the reader's exit cut short returns the bytes it got out instead
+    of raising (``-o - | head -c 100`` said "wrote <stdout>" and exited 0): the rest is
+    written again, which raises the broken pipe, and a write that takes nothing is one."""
     try:
-        sys.stdout.buffer.write(data)
+        rest = memoryview(data)
+        while rest:
+            written = sys.stdout.buffer.write(rest)
+            if not written:
+                raise BrokenPipeError("standard output took no bytes")
+            rest = rest[written:]
         sys.stdout.buffer.flush()
     except BrokenPipeError:
         raise

@@ -16,6 +16,7 @@ host runs 2 threads, not 64).
 """
 import contextlib
 import contextvars
+import functools
 import math
 import os
 import threading
@@ -49,9 +50,11 @@ _pools_lock = threading.Lock()
 _inside = threading.local()
 
 
+@functools.lru_cache(maxsize=8)
 def available_cpus(cgroup_root: str = _CGROUP, proc_cgroup: str = "/proc/self/cgroup") -> int:
     """The CPUs this process may use: its affinity mask, capped by its cgroup's CPU quota
-    (rounded up: a quota of 1.5 CPUs runs 2 threads), at least 1.
+    (rounded up: a quota of 1.5 CPUs runs 2 threads), at least 1. Read once per process
+    (a solve asks at every block map).
 
     Examples
     --------
@@ -196,7 +199,8 @@ def using_threads(count: int | None) -> Iterator[int]:
     if count is not None and (isinstance(count, bool) or not isinstance(count, int)
                               or count < 1):
         raise ValueError(f"threads must be a positive integer, not {count!r}")
-    token = _count.set(count if count is not None else _count.get())
+    # resolved once here: the default reads the environment and the cgroup's files
+    token = _count.set(count if count is not None else _count.get() or default_threads())
     resolved = current_threads()
     try:
         yield resolved
@@ -305,10 +309,12 @@ def _pool(count):
 
 
 def _forget_pools():
-    """A forked child has none of its parent's threads: its pools start anew."""
+    """A forked child has none of its parent's threads: its pools start anew (and it may
+    run under other CPU limits)."""
     global _pools_lock
     _pools.clear()
     _pools_lock = threading.Lock()
+    available_cpus.cache_clear()
 
 
 os.register_at_fork(after_in_child=_forget_pools)
