@@ -6,12 +6,16 @@ before anything walks the document: the composed YAML graph is measured with ali
 as often as they are used, in time linear in the graph's size.
 """
 import json
+import os
+import select
+import stat
+import sys
 from typing import Any
 
 import yaml
 
 from ..runtime.errors import InputError
-from .input_files import read_input_bytes
+from .input_files import BOM, read_input_bytes
 
 #: Largest handle file or manifest read, in bytes (real ones are a few KB).
 MAX_BYTES = 16 * 1024 * 1024
@@ -22,7 +26,9 @@ MAX_DEPTH = 100
 
 
 def load_document(path: str, kind: str) -> Any:
-    """Parsed content of ``path``; ``kind`` is ``"json"`` or ``"yaml"`` (JSON is YAML too).
+    """Parsed content of ``path``; ``kind`` is ``"json"``, ``"yaml"`` (JSON is YAML too) or
+    ``"content"`` (JSON where the text starts with ``{`` or ``[``, else YAML). ``path`` may
+    be a stream (see :func:`document_bytes`).
 
     Raises
     ------
@@ -37,9 +43,13 @@ def load_document(path: str, kind: str) -> Any:
     {'a': [1, 2], 'b': [1, 2]}
     >>> os.unlink(fh.name)
     """
-    data = read_input_bytes(path)
+    data = document_bytes(path)
+    size = f"more than {MAX_BYTES}" if is_stream(path) else str(len(data))  # a stream: cut
+    path = "<stdin>" if path == "-" else path  # as the messages name it
+    if kind == "content":
+        kind = "json" if data.lstrip()[:1] in (b"{", b"[") else "yaml"
     if len(data) > MAX_BYTES:
-        raise InputError(f"{path}: {len(data)} bytes; a {kind.upper()} document here is at most "
+        raise InputError(f"{path}: {size} bytes; a {kind.upper()} document here is at most "
                          f"{MAX_BYTES} bytes")
     try:
         text = data.decode("utf-8")
@@ -60,6 +70,90 @@ def load_document(path: str, kind: str) -> Any:
         mark = getattr(exc, "problem_mark", None)
         where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark is not None else ""
         raise InputError(f"{path}: not valid {kind.upper()}{where}: {first[:200]}") from None
+
+
+def is_stream(path: str) -> bool:
+    """Whether ``path`` is ``-`` (standard input) or names a pipe, a FIFO or a character
+    device (``/dev/stdin``, a process substitution's ``/dev/fd/63``): read once, by content."""
+    if path == "-":
+        return True
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return False
+    return stat.S_ISFIFO(mode) or stat.S_ISCHR(mode)
+
+
+#: what each stream gave, by its identity: a stream reads once, and a run asks more than once
+#: (the files a handle file names, then the handle file)
+_STREAMS: dict[tuple, bytes] = {}
+
+
+def document_bytes(path: str) -> bytes:
+    """The bytes of the document at ``path`` less a byte order mark: a regular file's (see
+    :func:`.input_files.read_input_bytes`), or a stream's (:func:`is_stream`), read once for
+    each stream and at most :data:`MAX_BYTES` and one more byte of it."""
+    if not is_stream(path):
+        return read_input_bytes(path)
+    key = _stream_key(path)
+    if key not in _STREAMS:
+        _STREAMS.clear()  # one stream's bytes kept at a time: a run reads one
+        _STREAMS[key] = _read_stream(path)
+    return _STREAMS[key]
+
+
+def _stream_key(path):
+    if path == "-":
+        return ("-", id(sys.stdin))  # a host that runs commands in-process swaps stdin
+    info = os.stat(path)
+    return (path, info.st_dev, info.st_ino)
+
+
+#: seconds a pipe may stay silent (no writer yet, or a writer that sends nothing) before its
+#: read is given up: a FIFO nobody writes to must not hold the run forever
+STREAM_WAIT = 30.0
+
+
+def _read_stream(path):
+    name = "<stdin>" if path == "-" else path
+    try:
+        if path == "-":
+            if sys.stdin is None or sys.stdin.closed:
+                raise InputError("<stdin>: standard input is closed; give a file instead of '-'")
+            data = sys.stdin.buffer.read(MAX_BYTES + 1)
+        else:
+            data = _read_pipe(path, name)
+    except OSError as exc:
+        raise InputError(f"{name}: cannot read: {exc.strerror or exc}") from None
+    if not data.strip():
+        raise InputError(f"{name}: the stream is empty")
+    return data[len(BOM):] if data.startswith(BOM) else data
+
+
+def _read_pipe(path, name):
+    """At most MAX_BYTES and one byte of a FIFO or device, waiting at most STREAM_WAIT
+    seconds for each chunk: opened without blocking (a FIFO's open waits for a writer), then
+    polled (on Linux a FIFO is not readable until a writer sends or closes)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    try:
+        poller = select.poll()
+        poller.register(fd, select.POLLIN)
+        chunks, total = [], 0
+        while total <= MAX_BYTES:
+            if not poller.poll(int(STREAM_WAIT * 1000)):
+                raise InputError(f"{name}: nothing came through it in {STREAM_WAIT:g} s (a "
+                                 "pipe nobody writes to?); give a file")
+            try:
+                chunk = os.read(fd, 1 << 20)
+            except BlockingIOError:
+                continue
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
 
 
 def _reason(exc):

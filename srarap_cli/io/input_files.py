@@ -1,9 +1,10 @@
 """Open the user's input files only when they are regular files.
 
-A FIFO, ``/dev/zero``, ``/dev/urandom`` or a socket given as a mesh or handle file would block
-forever or read without bound; the size checks that guard memory mean nothing for them. The
-file is opened without blocking and checked on the open descriptor, so nothing can swap it
-between the check and the read.
+A FIFO, ``/dev/zero``, ``/dev/urandom`` or a socket given as a mesh file would block forever
+or read without bound; the size checks that guard memory mean nothing for them. The file is
+opened without blocking and checked on the open descriptor, so nothing can swap it between the
+check and the read. (A mesh from a stream goes through ``mesh.stream``, a handle file from one
+through ``documents.document_bytes``: each bounded in size, and in waiting.)
 
 A UTF-8 byte order mark at the start of any input is skipped, so a file saved by an editor
 that writes one reads exactly like the same file without it.

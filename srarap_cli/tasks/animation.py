@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from ..io.documents import document_bytes
 from ..io.handles import Constraints
-from ..io.input_files import read_input_bytes
 from ..io.mesh.mesh import Mesh
 from ..runtime.errors import InputError, excerpt
 from ..solver.quaternion import align_hemisphere, multiply, normalize
@@ -161,8 +161,8 @@ def fingerprint(mesh: Mesh, paths: Sequence[str], opts: Settings, *extra: Any) -
     h = hashlib.sha256()
     for array in (mesh.vertices, mesh.face_sizes, mesh.face_vertices):
         h.update(np.ascontiguousarray(array).tobytes())
-    for path in paths:
-        h.update(hashlib.sha256(read_input_bytes(path)).digest())
+    for path in paths:  # a handle file from a pipe too: its bytes as read
+        h.update(hashlib.sha256(document_bytes(path)).digest())
     h.update(json.dumps([deciding(opts.as_dict()), *extra], sort_keys=True).encode())
     return h.hexdigest()
 

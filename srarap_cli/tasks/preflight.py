@@ -56,6 +56,9 @@ def refuse_overwrite(outputs: Sequence[str | None], *, mesh: str | None = None,
                      others: Sequence[tuple[str, str]] = ()) -> None:
     """Fail (exit 4) before any work when an output is one of the run's inputs: the mesh, the
     handle file, the files it names, or ``others`` ((what, path) pairs)."""
+    if mesh == "-" and handles == "-":
+        raise UsageProblem("MESH and HANDLES cannot both be '-': standard input holds one; "
+                           "give the other as a file or a pipe (<(...))")
     inputs = [("mesh", mesh)] if mesh not in (None, "-") else []
     if handles is not None:
         inputs.append(("handle file", handles))

@@ -10,7 +10,7 @@ from ...runtime.limits import MAX_COORDINATE
 from ...solver.api_checks import targets as checked_targets
 from ...solver.api_checks import vertex_ids
 from ...solver.settings import parse_mapping
-from ..documents import load_document
+from ..documents import is_stream, load_document
 from .fields import Context
 from .formats import read_def, read_sel
 from .keys import parse_track
@@ -120,17 +120,32 @@ def load_handles(path: str | os.PathLike, V: np.ndarray,
     path = str(path)
     if os.path.isdir(path):
         raise InputError(f"{path}: is a folder, not a handle file")
+    streamed = is_stream(path)
     if path.lower().endswith(".sel"):
+        if streamed:
+            raise InputError(f"{path}: a .sel file is read beside its .def; give it as a file")
         return _from_sel(path, V)
-    return parse_handles(_load_document(path), V, path, os.path.dirname(os.path.abspath(path)),
-                         fps, any_rate)
+    return parse_handles(_load_document(path), V, _shown(path), _base(path), fps, any_rate)
 
 
 def _load_document(path):
     ext = os.path.splitext(path)[1].lower()
+    if is_stream(path):  # standard input, a pipe, a process substitution: by content
+        return load_document(path, "json" if ext == ".json" else "content")
     if ext not in (".yaml", ".yml", ".json"):
-        raise InputError(f"{path}: handle file must be .yaml, .yml, .json or .sel")
+        raise InputError(f"{path}: handle file must be .yaml, .yml, .json or .sel (or come "
+                         "from a pipe or '-', read by its content)")
     return load_document(path, "json" if ext == ".json" else "yaml")
+
+
+def _shown(path):
+    return "<stdin>" if path == "-" else path
+
+
+def _base(path):
+    """The folder a handle file's relative paths start from: its own, or the working folder
+    for one from a stream."""
+    return os.getcwd() if is_stream(path) else os.path.dirname(os.path.abspath(path))
 
 
 def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = ".",
@@ -243,7 +258,7 @@ def referenced_files(handles: str | os.PathLike) -> list[str]:
     """Files a handle file names (``.dmat``, ``.sel``, ``.def``, ...): every string in it that
     is the path of an existing file, relative to the handle file; a ``.sel`` brings its ``.def``."""
     handles = str(handles)
-    base = os.path.dirname(os.path.abspath(handles))
+    base = _base(handles)
     if handles.lower().endswith(".sel"):
         return [os.path.splitext(handles)[0] + ".def"]
     try:
