@@ -177,6 +177,61 @@ def test_an_output_a_symlink_carries_outside_the_folder_is_refused(tmp_path):
     assert "leads out of the output folder" in line and not list(elsewhere.iterdir())
 
 
+@pytest.mark.parametrize("linked", ["x.obj.srarap.json", "summary.csv", "summary.json"])
+def test_a_record_or_summary_a_symlink_carries_outside_is_refused_before_any_job(tmp_path,
+                                                                                 linked):
+    """Issue 61: the job's record and the summaries were written through links to anywhere
+    (a victim file overwritten by the record, a summary created outside ``-o``)."""
+    out = tmp_path / "out"
+    out.mkdir()
+    victim = tmp_path / "victim"
+    victim.write_text("precious")
+    (out / linked).symlink_to(victim)
+    line = one_line(run_cli(["batch", _manifest(tmp_path, ["x.obj"]), "-o", out]), 4)
+    assert "leads out of the output folder" in line and victim.read_text() == "precious"
+    assert not (out / "x.obj").exists()
+
+
+def test_a_link_made_while_the_batch_runs_carries_nothing_outside(tmp_path):
+    """The check that runs before the jobs cannot see a link made after it: each write checks
+    again when it happens, and the job fails without writing (its mesh and record stay
+    out of the other folder)."""
+    from srarap_cli.tasks.batch.manifest import check_outputs, load_manifest
+    from srarap_cli.tasks.batch.run import run_batch
+
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    out.mkdir()
+    elsewhere.mkdir()
+    manifest = _manifest(tmp_path, ["a.obj", "sub/b.obj"])
+    jobs = load_manifest(str(manifest))
+    check_outputs(jobs, str(out), str(manifest))  # nothing leads out yet
+    (out / "sub").symlink_to(elsewhere)           # ... then a link appears
+    rows = {r.job: r for r in run_batch(jobs, str(out))}
+    assert rows["j0"].status.value == "ok" and (out / "a.obj").exists()
+    assert rows["j1"].status.value == "failed" and "leads out of the output folder" in \
+        rows["j1"].message
+    assert not list(elsewhere.iterdir())
+
+
+def test_commit_files_inside_a_folder_refuses_every_way_out(tmp_path):
+    from srarap_cli.runtime.commit import commit_files
+    from srarap_cli.runtime.errors import OutputError
+
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    out.mkdir()
+    elsewhere.mkdir()
+    (out / "link.txt").symlink_to(elsewhere / "target.txt")
+    (out / "dir").symlink_to(elsewhere)
+    for name in ("link.txt", "dir/x.txt", "dir/new/y.txt", "../escape.txt"):
+        with pytest.raises(OutputError, match="leads out of the output folder"):
+            commit_files([(str(out / "ok.txt"), b"1"), (str(out / name), b"2")], inside=str(out))
+    assert not list(elsewhere.iterdir()) and not (out / "ok.txt").exists()
+    assert not (tmp_path / "escape.txt").exists()
+    commit_files([(str(out / "ok.txt"), b"1"), (str(out / "new" / "z.txt"), b"2")],
+                 inside=str(out))
+    assert (out / "new" / "z.txt").read_bytes() == b"2"
+
+
 def test_a_symlink_that_loops_is_never_replaced_by_a_file(tmp_path):
     (tmp_path / "loop.obj").symlink_to("loop.obj")
     line = one_line(run_cli(["deform", BAR, TWIST, "-o", "loop.obj"], cwd=tmp_path), 6)

@@ -81,7 +81,7 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     # cost the account of the jobs whose outputs are on disk
     commit_files([(os.path.join(out, "summary.csv"), utf8(_csv(summary_rows))),
                   (os.path.join(out, "summary.json"),
-                   utf8(json.dumps(summary_rows, indent=2) + "\n"))])
+                   utf8(json.dumps(summary_rows, indent=2) + "\n"))], inside=out)
     _tell(rows, out, quiet, stopped)
     _write_reports(rows, manifest, report, junit)
     if stopped is not None:

@@ -15,6 +15,7 @@ import stat
 import tempfile
 
 from .errors import OutputError
+from .paths import leads_out
 
 #: Paths this process has committed, in order: a signal that arrives after a commit is
 #: reported with what was written, not as "no output written".
@@ -22,9 +23,13 @@ COMMITTED: list[str] = []
 _SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
-def commit_files(files: list[tuple[str, bytes]]) -> None:
+def commit_files(files: list[tuple[str, bytes]], inside: str | None = None) -> None:
     """Write ``[(path, bytes), ...]`` as one unit: on any failure every target is left exactly
     as it was (not created, or its old content).
+
+    ``inside``: a folder every target must stay in, symbolic links followed, checked before
+    anything is written and again just before the renames (a batch's ``-o``: a link in it,
+    made before the run or while it goes on, must not carry a file anywhere else).
 
     Every payload goes to a temporary file in its target's folder first; only when all are
     written are they renamed over the targets (a rename within a folder is atomic). A target
@@ -38,6 +43,7 @@ def commit_files(files: list[tuple[str, bytes]]) -> None:
     staged: list = []
     made: list[str] = []  # folders this commit made, to remove again should it fail
     done = False
+    _stay_inside(files, inside)
     try:
         _make_folders([path for path, _ in files], made)
         through = []
@@ -53,6 +59,7 @@ def commit_files(files: list[tuple[str, bytes]]) -> None:
         # until both are done, so the report always matches the files on disk
         blocked = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
         try:
+            _stay_inside(files, inside)
             _replace_all(staged)
             done = True
         finally:
@@ -62,6 +69,17 @@ def commit_files(files: list[tuple[str, bytes]]) -> None:
             _remove(tmp)
         if not done:
             _remove_folders(made)
+
+
+def _stay_inside(files, inside):
+    """OutputError for the first target that leads out of ``inside`` (None: no folder)."""
+    if inside is None:
+        return
+    for path, _ in files:
+        target = leads_out(path, inside)
+        if target is not None:
+            raise OutputError(f"{path}: leads out of the output folder {inside} (through a "
+                              f"symbolic link, to {target}); nothing written")
 
 
 def _make_folders(paths, made):

@@ -45,3 +45,20 @@ def refuse_overwriting_inputs(outputs: Sequence[str], inputs: Sequence[tuple[str
         if hit is not None:
             what, path = hit
             raise InputError(f"{out}: is the {what} ({path}); refusing to overwrite an input")
+
+
+def leads_out(path: str, folder: str) -> str | None:
+    """Where ``path`` would be written when that is outside ``folder`` (its real path,
+    symbolic links followed, in the file's name and in every folder above it); None when it
+    stays inside. Asked at the moment of writing: a link made while a run goes on counts.
+
+    Examples
+    --------
+    >>> leads_out("res/a/b.obj", "res") is None
+    True
+    >>> leads_out("res/../x.obj", "res") is not None
+    True
+    """
+    root = os.path.realpath(folder)
+    target = os.path.realpath(path)
+    return None if os.path.commonpath([root, target]) == root else target

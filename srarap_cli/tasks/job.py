@@ -56,6 +56,8 @@ class DeformJob:
     expect : mapping, optional, ``golden`` (path), ``tol``, ``relative``: compare with it
     record : bool, keep a record beside the output and take an unchanged job's result from
         it without solving (batches)
+    inside : str, optional, a folder every file the job writes must stay in, symbolic links
+        followed, at the moment it is written (a batch's ``-o``)
     """
 
     mesh: str
@@ -76,6 +78,7 @@ class DeformJob:
     frame: float = 0.0
     expect: Mapping[str, Any] | None = None
     record: bool = False
+    inside: str | None = None
 
 
 def run_job(job: DeformJob, callback: Callable[[dict], None] | None = None,
@@ -206,7 +209,7 @@ def _solve(job, fmt, callback, write_stdout, key):
             notes + lost)))
     if keep and job.output == "-" and write_stdout is not None:
         write_stdout(mesh_bytes)  # first: the files are committed only once it was written
-    commit_files(files)
+    commit_files(files, inside=job.inside)
     peaks["write"] = memory.stop(peak)
     return JobResult(job.name, status, status.exit_code, warnings=notes + lost,
                      stop=solve.stop_reason.value, iterations=solve.iterations,

@@ -7,12 +7,14 @@ from ...io.documents import load_document
 from ...io.handles import referenced_files
 from ...io.mesh.formats import extensions, suffix_of
 from ...runtime.errors import InputError, excerpt, unknown_key
-from ...runtime.paths import refuse_overwriting_inputs
+from ...runtime.paths import leads_out, refuse_overwriting_inputs
 from ...solver.settings import parse_mapping
 from .rows import Job
 
 TOP_KEYS = ("jobs", "defaults")
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
+#: the files a batch writes beside its jobs' in the output folder
+SUMMARIES = ("summary.csv", "summary.json")
 EXPECT_KEYS = ("golden", "tol", "relative")
 
 
@@ -112,19 +114,25 @@ def check_outputs(jobs: list[Job],
     _stay_inside(jobs, out_dir)
     outputs = [os.path.join(out_dir, name) for job in jobs
                for name in (job["output"], job["output"] + ".srarap.json")]
-    outputs += [os.path.join(out_dir, name) for name in ("summary.csv", "summary.json")]
+    outputs += [os.path.join(out_dir, name) for name in SUMMARIES]
     refuse_overwriting_inputs(outputs, inputs)
 
 
 def _stay_inside(jobs, out_dir):
-    """Refuse an output that a symbolic link inside ``out_dir`` would carry outside it (the
-    names were checked as text when the manifest was read)."""
-    root = os.path.realpath(out_dir)
+    """Refuse, before any job runs, an output, a record or a summary that a symbolic link
+    inside ``out_dir`` would carry outside it (the names were checked as text when the
+    manifest was read; the writes check again when they happen)."""
     for job in jobs:
-        target = os.path.realpath(os.path.join(out_dir, job["output"]))
-        if os.path.commonpath([root, target]) != root:
-            raise InputError(f"job {job['name']!r}: output {job['output']!r} leads out of the "
-                             f"output folder {out_dir} (through a symbolic link, to {target})")
+        for name in (job["output"], job["output"] + ".srarap.json"):
+            target = leads_out(os.path.join(out_dir, name), out_dir)
+            if target is not None:
+                raise InputError(f"job {job['name']!r}: {name!r} leads out of the output "
+                                 f"folder {out_dir} (through a symbolic link, to {target})")
+    for name in SUMMARIES:
+        target = leads_out(os.path.join(out_dir, name), out_dir)
+        if target is not None:
+            raise InputError(f"{os.path.join(out_dir, name)}: leads out of the output folder "
+                             f"{out_dir} (through a symbolic link, to {target})")
 
 
 def _settings(where, key, spec):

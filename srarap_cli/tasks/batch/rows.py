@@ -26,7 +26,8 @@ def deform_job(job: Job, out_dir: str, keep_unconverged: bool = False) -> Deform
     under ``out_dir`` and keeping its record there."""
     return DeformJob(job["mesh"], job["handles"], os.path.join(out_dir, job["output"]),
                      settings=job["settings"], name=job["name"],
-                     keep_unconverged=keep_unconverged, expect=job["expect"], record=True)
+                     keep_unconverged=keep_unconverged, expect=job["expect"], record=True,
+                     inside=out_dir)
 
 
 def interrupted_row(job: Job, out_dir: str | None = None, keep_unconverged: bool = False,
