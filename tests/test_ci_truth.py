@@ -383,8 +383,8 @@ def test_a_sigint_as_a_job_commits_reports_it_done(tmp_path, monkeypatch):
 
     real = commit.commit_files
 
-    def commit_then_interrupt(files):
-        real(files)
+    def commit_then_interrupt(files, **kwargs):
+        real(files, **kwargs)
         if any(path.endswith(".srarap.json") for path, _ in files):
             raise KeyboardInterrupt
 

@@ -370,9 +370,9 @@ SECOND_SIGNAL_AT_THE_SUMMARY = """
 import os, signal
 from srarap_cli.cli import batch
 real = batch.commit_files
-def commit_files(files):
+def commit_files(files, **kwargs):
     os.kill(os.getpid(), signal.SIGTERM)
-    return real(files)
+    return real(files, **kwargs)
 batch.commit_files = commit_files
 """
 

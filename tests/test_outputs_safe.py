@@ -115,9 +115,9 @@ def test_a_folder_placed_at_a_target_after_the_check_leaves_every_output_as_it_w
     (folder / "o.obj").write_bytes(b"previous mesh")
     real = commit.commit_files
 
-    def swap_then_commit(files):
+    def swap_then_commit(files, **kwargs):
         os.mkdir(folder / "o.csv")  # the log's target became a folder after the check
-        return real(files)
+        return real(files, **kwargs)
 
     monkeypatch.setattr("srarap_cli.tasks.job.commit_files", swap_then_commit)
     monkeypatch.chdir(folder)
