@@ -327,3 +327,55 @@ def test_a_yaml_error_says_its_reason_not_only_its_context(tmp_path):
     (tmp_path / "h.yaml").write_text("groups:\n\tbase: {indices: [0], fixed: true}\n")
     line = one_line(run_cli(["info", BAR, tmp_path / "h.yaml"]), 4)
     assert "found character '\\t' that cannot start any token" in line and "line 2" in line
+
+
+# --- duplicate keys ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name, text, key, line", [
+    ("groups.yaml", "groups: {fix: {indices: [0, 1, 2, 3], fixed: true},\n"
+     "         fix: {indices: [12, 13, 14, 15], translate: [0, 0, 1]}}\n", "'fix'", 2),
+    ("group.yaml", "groups:\n  top:\n    indices: [12, 13]\n    rotate: {axis: [0, 0, 1], "
+     "angle_deg: 90}\n    rotate: {axis: [0, 0, 1], angle_deg: 45}\n", "'rotate'", 5),
+    ("top.yaml", "groups: {a: {indices: [0], fixed: true}}\ngroups: {b: {indices: [1], "
+     "fixed: true}}\n", "'groups'", 2),
+    ("groups.json", '{"groups": {"fix": {"indices": [0, 1], "fixed": true},\n'
+     '"fix": {"indices": [12, 13], "translate": [0, 0, 1]}}}', '"fix"', 2),
+    ("group.json", '{"groups": {"a": {"indices": [0], "fixed": true,\n"fixed": false}}}',
+     '"fixed"', 2),
+])
+def test_a_key_given_twice_is_refused_naming_it_and_its_line(tmp_path, name, text, key, line):
+    """Issue 61: the loaders kept the last of two equal keys without a word (a group's held
+    vertices no longer held, a second ``jobs:`` list dropping the first)."""
+    path = tmp_path / name
+    path.write_text(text)
+    said = one_line(run_cli(["deform", BAR, path, "-o", tmp_path / "o.obj"]), 4)
+    assert f"key {key} given twice" in said and f"line {line}" in said, said
+    assert not (tmp_path / "o.obj").exists()
+    from srarap_cli.io.handles import load_handles
+    from srarap_cli.io.mesh import read_mesh
+    from srarap_cli.runtime.errors import InputError
+
+    with pytest.raises(InputError, match="given twice"):  # the API's loader too
+        load_handles(str(path), read_mesh(BAR).vertices)
+
+
+def test_a_manifest_with_two_job_lists_or_a_job_key_twice_is_refused(tmp_path):
+    for text, key in [(f"jobs:\n  - {{name: a, mesh: {BAR}, handles: {TWIST}, output: a.obj}}\n"
+                       f"jobs:\n  - {{name: b, mesh: {BAR}, handles: {TWIST}, output: b.obj}}\n",
+                       "'jobs'"),
+                      (f"jobs:\n  - {{name: a, mesh: {BAR}, handles: {TWIST}, output: a.obj,"
+                       " output: b.obj}\n", "'output'")]:
+        (tmp_path / "m.yaml").write_text(text)
+        said = one_line(run_cli(["batch", tmp_path / "m.yaml", "-o", tmp_path / "out"]), 4)
+        assert f"key {key} given twice" in said, said
+        assert not (tmp_path / "out").exists()
+
+
+def test_the_same_key_in_other_mappings_and_yaml_merges_still_load(tmp_path):
+    path = tmp_path / "h.yaml"
+    path.write_text("base: &b {fixed: true}\ngroups:\n  a: {<<: *b, indices: [0, 1]}\n"
+                    "  b: {<<: *b, indices: [2, 3]}\n")
+    from srarap_cli.io.documents import load_document
+
+    doc = load_document(str(path), "yaml")
+    assert doc["groups"]["b"] == {"fixed": True, "indices": [2, 3]}

@@ -1,4 +1,5 @@
-"""Read a YAML or JSON document (handle file, batch manifest) within bounds.
+"""Read a YAML or JSON document (handle file, batch manifest) within bounds, and refuse a
+key given twice in one mapping (both loaders keep the last one without a word).
 
 A few hundred bytes of YAML can name a node that aliases expand to 10^9 nodes (a "billion
 laughs"), and a deeply nested document overflows the parser's recursion. Both are refused
@@ -54,7 +55,7 @@ def load_document(path: str, kind: str) -> Any:
     try:
         text = data.decode("utf-8")
         if kind == "json":
-            doc = json.loads(text)
+            doc = json.loads(text, object_pairs_hook=lambda pairs: _unique(pairs, text, path))
             _check_tree(doc, path)
             return doc
         _check_graph(yaml.compose(text, Loader=yaml.SafeLoader), path)
@@ -204,6 +205,8 @@ def _check_graph(root, path):
                     stack.append((kid, False))
             continue
         open_.discard(key)
+        if isinstance(node, yaml.MappingNode):
+            _duplicate_key(node, path)
         size[key] = 1 + sum(size[id(k)] for k in kids)
         depth[key] = 1 + max((depth[id(k)] for k in kids), default=0)
         if size[key] > MAX_NODES:
@@ -211,6 +214,35 @@ def _check_graph(root, path):
                              "counted where they are used)")
         if depth[key] > MAX_DEPTH:
             raise InputError(f"{path}: nested too deeply (at most {MAX_DEPTH} levels)")
+
+
+def _unique(pairs, text, path):
+    """A JSON object's dict, or InputError for a key given twice (json keeps the last one
+    silently: a group's or a manifest's entries dropped without a word), with the line of
+    its second appearance where the text shows it once more than once."""
+    seen = set()
+    for key, _ in pairs:
+        if key in seen:
+            quoted = json.dumps(key)
+            at = [k for k in range(len(text)) if text.startswith(quoted, k)]
+            line = f" (line {text.count(chr(10), 0, at[1]) + 1})" if len(at) == 2 else ""
+            raise InputError(f"{path}: key {quoted} given twice in one object{line}; the "
+                             "first would be dropped")
+        seen.add(key)
+    return dict(pairs)
+
+
+def _duplicate_key(node, path):
+    """InputError for a YAML mapping that gives a key twice (the loader keeps the last one
+    silently), naming the key and the line of its second appearance."""
+    seen = set()
+    for key, _ in node.value:
+        if not isinstance(key, yaml.ScalarNode) or key.value == "<<":  # merges: YAML's own
+            continue
+        if (key.tag, key.value) in seen:
+            raise InputError(f"{path}: key {key.value!r} given twice in one mapping (line "
+                             f"{key.start_mark.line + 1}); the first would be dropped")
+        seen.add((key.tag, key.value))
 
 
 def _check_tree(doc, path):
