@@ -151,6 +151,26 @@ def test_names_the_shell_allows_are_written_escaped_where_the_format_needs_it(tm
     assert json.loads((tmp_path / "out" / "summary.json").read_text())[0]["job"] == "x\ud800y"
 
 
+def test_summary_csv_holds_one_row_a_job_whatever_its_name_or_message_holds(tmp_path):
+    """Issue 61: a lone carriage return in a job's name (or message) went into summary.csv
+    unquoted, and every CSV reader saw an extra row."""
+    import csv
+
+    names = ["cr\rin the middle", "lf\nin the middle", "crlf\r\nboth", "plain", 'q"uote,comma']
+    manifest = tmp_path / "m.json"
+    manifest.write_text(json.dumps({"jobs": [
+        {"name": name, "mesh": BAR, "handles": TWIST, "output": f"o{k}.obj"}
+        for k, name in enumerate(names)]}))
+    r = run_cli(["batch", manifest, "-o", tmp_path / "out", "-q"])
+    assert r.returncode == 0, r.stderr
+    with open(tmp_path / "out" / "summary.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [row["job"] for row in rows] == names
+    with open(tmp_path / "out" / "summary.csv", newline="") as fh:
+        plain = fh.read().split("\n")
+    assert any(line.startswith("plain,") for line in plain)  # ordinary rows stay unquoted
+
+
 # --- manifests ------------------------------------------------------------------------------
 
 def _manifest(tmp_path, outputs):
@@ -379,3 +399,39 @@ def test_the_same_key_in_other_mappings_and_yaml_merges_still_load(tmp_path):
 
     doc = load_document(str(path), "yaml")
     assert doc["groups"]["b"] == {"fixed": True, "indices": [2, 3]}
+
+
+# --- records ----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("change", [
+    {"iterations": "many"}, {"status": "bogus"}, {"warnings": 5}, {"warnings": [1, 2]},
+    {"energy": "low"}, {"iterations": True}, {"stop": "<script>alert(1)</script>"},
+    {"status": "up-to-date"}])
+def test_a_record_with_fields_srarap_never_writes_is_no_record(tmp_path, change):
+    """Issue 61: a record carrying the job's fingerprint (a restored CI cache, a shared
+    folder) with a field of the wrong type ended the batch with exit 1 after its summary, and
+    its ``stop`` went into the report unescaped. Such a record is now no record: the job is
+    solved again, and the report escapes every field."""
+    manifest = _manifest(tmp_path, ["x.obj"])
+    out = tmp_path / "out"
+    assert run_cli(["batch", manifest, "-o", out, "-q"]).returncode == 0
+    sidecar = out / "x.obj.srarap.json"
+    rec = json.loads(sidecar.read_text())
+    sidecar.write_text(json.dumps({**rec, **change}))
+    r = run_cli(["batch", manifest, "-o", out, "-q", "--report", out / "r.html"])
+    assert r.returncode == 0, r.stderr
+    row = json.loads((out / "summary.json").read_text())[0]
+    assert row["status"] == "ok"  # solved again: not "up-to-date" from the doctored record
+    assert "<script>" not in (out / "r.html").read_text()
+    assert json.loads(sidecar.read_text()) == rec  # and the record written anew
+
+
+def test_the_report_escapes_every_field_of_a_row():
+    from srarap_cli.tasks.batch.report import report_html
+    from srarap_cli.tasks.job_status import JobResult, JobStatus
+
+    row = JobResult("j<b>", JobStatus.OK, 0, stop="<script>x</script>", message="<i>m</i>",
+                    warnings=["<w>"])
+    page = report_html([row], {"j<b>": {}}, "t<t>")
+    assert "<script>" not in page and "<i>" not in page and "<w>" not in page
+    assert "&lt;script&gt;" in page

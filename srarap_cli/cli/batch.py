@@ -142,8 +142,15 @@ def printable(text: str) -> str:
 
 
 def _csv(rows):
+    """summary.csv: one line a job. A row with a lone carriage return in a field (a job's
+    name or message) has every field quoted: the writer quotes only what holds its line
+    terminator, and every CSV reader took the bare ``\r`` for the end of a row."""
     buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=SUMMARY_FIELDS, lineterminator="\n")
-    w.writeheader()
-    w.writerows({**r, "warnings": WARNING_JOIN.join(r["warnings"])} for r in rows)
+    plain = csv.DictWriter(buf, fieldnames=SUMMARY_FIELDS, lineterminator="\n")
+    quoted = csv.DictWriter(buf, fieldnames=SUMMARY_FIELDS, lineterminator="\n",
+                            quoting=csv.QUOTE_ALL)
+    plain.writeheader()
+    for r in rows:
+        row = {**r, "warnings": WARNING_JOIN.join(r["warnings"])}
+        (quoted if any("\r" in str(v) for v in row.values()) else plain).writerow(row)
     return buf.getvalue()

@@ -10,6 +10,7 @@ from typing import Any
 from ..io.handles import referenced_files
 from ..io.input_files import read_input_bytes
 from ..runtime.errors import InputError
+from ..solver.stop import StopReason
 
 #: what a record keeps of a job's result
 RECORDED = ("status", "iterations", "energy", "stop", "warnings")
@@ -52,9 +53,27 @@ def read_record(sidecar: str, key: str) -> dict[str, Any] | None:
             rec = json.load(fh)
     except (OSError, ValueError):
         return None
-    if not isinstance(rec, dict) or rec.get("fingerprint") != key or "status" not in rec:
+    if not isinstance(rec, dict) or rec.get("fingerprint") != key or not _well_formed(rec):
         return None
     return {k: rec.get(k) for k in RECORDED} | {"warnings": list(rec.get("warnings") or [])}
+
+
+#: what a record's status and stop can say (what :func:`record_bytes` writes)
+STATUSES = ("ok", "not-converged")
+STOPS = frozenset(reason.value for reason in StopReason) | {""}
+
+
+def _well_formed(rec: dict[str, Any]) -> bool:
+    """Whether every field of a record has the type and values srarap writes: one that does
+    not (a hand-edited or foreign file with the job's fingerprint) is no record, and the job
+    runs again."""
+    def number(value, kinds):
+        return value is None or (isinstance(value, kinds) and not isinstance(value, bool))
+
+    warnings = rec.get("warnings", [])
+    return (rec.get("status") in STATUSES and rec.get("stop", "") in STOPS
+            and number(rec.get("iterations"), int) and number(rec.get("energy"), (int, float))
+            and isinstance(warnings, list) and all(isinstance(w, str) for w in warnings))
 
 
 def record_bytes(key: str, status: str, iterations: int | None, energy: float | None,

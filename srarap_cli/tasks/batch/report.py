@@ -78,7 +78,7 @@ def _job(row, pictures):
                ("tolerance", _number(row.tol, "g")),
                ("warnings", str(len(row.warnings)))]
     table = ("<tr>" + "".join(f"<th>{k}</th>" for k, _ in numbers) + "</tr><tr>"
-             + "".join(f"<td>{v}</td>" for _, v in numbers) + "</tr>")
+             + "".join(f"<td>{html.escape(v)}</td>" for _, v in numbers) + "</tr>")
     figures = "".join(
         f"<figure><img alt=\"{html.escape(caption)}\" src=\"data:image/png;base64,"
         f"{pictures[key]}\"><figcaption>{html.escape(caption)}</figcaption></figure>"
