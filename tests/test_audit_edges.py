@@ -435,3 +435,18 @@ def test_the_report_escapes_every_field_of_a_row():
     page = report_html([row], {"j<b>": {}}, "t<t>")
     assert "<script>" not in page and "<i>" not in page and "<w>" not in page
     assert "&lt;script&gt;" in page
+
+
+@pytest.mark.parametrize("resume", [False, True])
+def test_an_animation_run_again_with_fewer_frames_leaves_only_its_own(tmp_path, resume):
+    """Issue 61: a rerun with fewer frames left the earlier run's later frames beside the
+    new ones, and ``render 'f_{}.obj'`` drew a mixed animation."""
+    keys = os.path.join(ROOT, "configs", "bar-twist-animated.yaml")
+    pattern = str(tmp_path / "fr" / "f_{:02d}.obj")
+    first = run_cli(["animate", BAR, keys, "-o", pattern, "--frames", "6", "-q"])
+    assert first.returncode == 0, first.stderr
+    again = run_cli(["animate", BAR, keys, "-o", pattern, "--frames", "3", "-q"]
+                    + (["--resume"] if resume else []))
+    assert again.returncode == 0, again.stderr
+    assert sorted(os.listdir(tmp_path / "fr")) == ["f_00.obj", "f_01.obj", "f_02.obj"]
+    assert "removed 3 later frame(s) of an earlier run" in again.stderr

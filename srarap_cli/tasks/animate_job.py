@@ -127,24 +127,26 @@ def run_animation(job: AnimateJob,
                          state=state, on_frame=write_frame, fingerprint=run_id)
     rows = (final.rows if final is not None else []) + (
         [animator.stopped_row] if animator.stopped_at is not None else [])
-    notes = animator.warnings + lost + _finish(job, rows, animator.stopped_at, state_path)
+    notes = animator.warnings + lost + _finish(job, rows, animator.stopped_at, state_path,
+                                               n_frames)
     return AnimationOutcome(rows, n_frames, 0 if state is None else state.frame + 1,
                             animator.stopped_at, notes, animator.last_result)
 
 
-def _finish(job, rows, stopped, state_path):
-    """Write the log; drop the resume state of a finished run, or the frames an earlier run
-    left after the frame this one stopped at. Returns the warnings to say."""
+def _finish(job, rows, stopped, state_path, n_frames):
+    """Write the log; drop the resume state of a finished run; remove the frames an earlier
+    run left from the frame this one stopped at, or past its last frame (an earlier run of
+    more frames: ``render 'f_{}.obj'`` would draw both runs' frames as one animation).
+    Returns the warnings to say."""
     if job.log is not None:
         text = format_log(rows, os.path.splitext(job.log)[1].lower(), FRAME_FIELDS)
         commit_files([(job.log, utf8(text))])
-    if stopped is None:
-        if os.path.exists(state_path):
-            os.unlink(state_path)
-        return []
-    removed = remove_stale(job.pattern, stopped)
+    if stopped is None and os.path.exists(state_path):
+        os.unlink(state_path)
+    first = n_frames if stopped is None else stopped
+    removed = remove_stale(job.pattern, first)
     return [f"removed {removed} later frame(s) of an earlier run under {job.pattern!r} "
-            f"(frame {stopped} on), so that the frames on disk are this run's"] if removed else []
+            f"(frame {first} on), so that the frames on disk are this run's"] if removed else []
 
 
 def _resume_state(path, key):
