@@ -247,3 +247,45 @@ def test_the_command_writes_the_same_bytes_at_one_two_and_three_threads(tmp_path
                 threads, env={one_triangle.ENV: "rslab"})
     outputs = [(tmp_path / f"t{k}.ply").read_bytes() for k in (1, 2, 3)]
     assert outputs[0] == outputs[1] == outputs[2]
+
+
+def test_a_thread_that_cannot_start_leaves_the_blocks_to_the_caller(monkeypatch):
+    """Under ``ulimit -v`` a thread may get no stack: the blocks run on the calling thread,
+    with the same answers (issue 61: "can't start new thread" was an internal error)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    def refuse(self, *args, **kwargs):
+        raise RuntimeError("can't start new thread")
+
+    with using_threads(3):
+        expected = map_blocks(lambda k: k * k, range(9))
+        monkeypatch.setattr(ThreadPoolExecutor, "submit", refuse)
+        assert map_blocks(lambda k: k * k, range(9)) == expected
+
+
+def test_a_background_stage_that_cannot_get_a_thread_runs_in_turn(monkeypatch):
+    import threading
+
+    from srarap_cli.runtime.threads import background
+
+    def refuse(self):
+        raise RuntimeError("can't start new thread")
+
+    monkeypatch.setattr(threading.Thread, "start", refuse)
+    assert background(lambda: 6 * 7)() == 42
+
+
+@pytest.mark.parametrize("exc, code", [
+    (RuntimeError("can't start new thread"), 4),
+    (RuntimeError("Resource temporarily unavailable"), 4),  # libigl's pthread_create
+    (RuntimeError("SuperLU malloc failed"), 4),
+    (OSError(12, "Cannot allocate memory"), 4),
+    (BlockingIOError(11, "Resource temporarily unavailable"), 6),  # a busy pipe: not memory
+])
+def test_every_failure_to_get_memory_or_a_thread_is_exit_4(exc, code):
+    from srarap_cli.runtime.failures import classify
+
+    got, line = classify(exc)
+    assert got == code and "\n" not in line
+    if code == 4:
+        assert line.startswith("out of memory")

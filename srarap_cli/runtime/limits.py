@@ -23,7 +23,11 @@ MAX_COORDINATE = 1e150
 # mappings (VmSize) once numpy, scipy, libigl, yaml and click are loaded
 ADDRESS_SPACE_BASE = 300_000_000
 # SuperLU and libigl report a failed allocation in their own words
-_OOM_WORDS = ("malloc", "out of memory", "not enough memory", "bad_alloc", "cannot allocate")
+_OOM_WORDS = ("malloc", "out of memory", "not enough memory", "bad_alloc", "cannot allocate",
+              "can't start new thread")
+#: a thread a library could not start (libigl's, under ``ulimit -v``: pthread_create's EAGAIN
+#: as a RuntimeError); as an OSError the same words are a busy pipe, not memory
+_THREAD_WORDS = ("resource temporarily unavailable",)
 
 
 def _from_env():
@@ -107,10 +111,12 @@ def memory_note() -> str:
 
 def is_out_of_memory(exc: BaseException) -> bool:
     """Whether ``exc`` is a failed allocation reported as something else (SuperLU's malloc
-    failures arrive as RuntimeError, C++'s bad_alloc as various types)."""
+    failures arrive as RuntimeError, C++'s bad_alloc as various types, a thread that could
+    not get its stack as RuntimeError)."""
     text = str(exc).lower()
     return isinstance(exc, (RuntimeError, OSError, ValueError)) and any(
-        word in text for word in _OOM_WORDS) or (isinstance(exc, OSError) and exc.errno == 12)
+        word in text for word in _OOM_WORDS) or (isinstance(exc, OSError) and exc.errno == 12) \
+        or (type(exc) is RuntimeError and any(word in text for word in _THREAD_WORDS))
 
 
 def _refuse(what, need, have):

@@ -270,9 +270,14 @@ def map_blocks(func: Callable[[T], R], blocks: Iterable[T]) -> list[R]:
         finally:
             _inside.busy = busy
 
-    pool = _pool(count - 1)
     context = contextvars.copy_context()
-    helpers = [pool.submit(context.copy().run, take_blocks) for _ in range(count - 1)]
+    helpers = []
+    try:
+        pool = _pool(count - 1)
+        for _ in range(count - 1):
+            helpers.append(pool.submit(context.copy().run, take_blocks))
+    except RuntimeError:  # a thread that cannot start (no room for its stack): this thread
+        pass              # takes the blocks instead, and the answer is the same
     take_blocks()
     for helper in helpers:
         helper.result()

@@ -143,10 +143,14 @@ def background(func: Callable[[], T]) -> Callable[[], T]:
             out["error"] = exc
 
     thread = threading.Thread(target=run, daemon=True)
-    thread.start()
+    try:
+        thread.start()
+    except RuntimeError:  # no room for a thread's stack: the work runs here, in turn
+        run()
 
     def wait():
-        thread.join()
+        if thread.ident is not None:
+            thread.join()
         if "error" in out:
             raise out["error"]
         return out["value"]
