@@ -108,6 +108,36 @@ def test_a_long_deform_shows_progress_on_a_terminal_only(tmp_path):
     cmd = [sys.executable, "-m", "srarap_cli", "deform", spot, nod, "-o", str(tmp_path / "o.obj"),
            "--accel", "none", "--start", "laplacian", "--tol", "0", "--max-iter", "150"]
     text = stderr_on_a_terminal(cmd)
-    assert "\riteration " in text and "energy " in text and "change " in text
+    # each redraw clears the line first (a shorter line left the longer one's tail)
+    assert "\r\x1b[Kiteration " in text and "energy " in text and "change " in text
     piped = subprocess.run(cmd, capture_output=True, text=True, check=True, timeout=600)
     assert "\riteration" not in piped.stderr and "srarap deform:" in piped.stderr
+    assert "srarap: progress:" not in piped.stderr  # a short run: no line in a log
+
+
+def test_a_log_shows_the_warnings_then_progress_lines_before_the_solve_ends(tmp_path):
+    """Issue 60: with stderr to a file (a CI log) nothing came until the process ended, and a
+    warning known before the solve came after it. Now the warning first, then progress lines
+    (here every 0.05 s) naming the level, then the summary."""
+    spot = os.path.join(ROOT, "sample_meshes", "spot.obj")
+    nod = open(os.path.join(ROOT, "configs", "spot-nod.yaml")).read()
+    (tmp_path / "h.yaml").write_text(nod.replace("angle_deg: -30", "angle_rad: 30"))
+    with open(tmp_path / "log.txt", "w") as log:
+        done = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", spot, "h.yaml",
+                               "-o", "o.obj", "--multires", "1000"], cwd=tmp_path,
+                              stderr=log, timeout=600,
+                              env={**os.environ, "SRARAP_PROGRESS_EVERY": "0.05"})
+    assert done.returncode == 0
+    lines = (tmp_path / "log.txt").read_text().splitlines()
+    warned = next(k for k, line in enumerate(lines) if "more than a full turn" in line)
+    progress = [k for k, line in enumerate(lines) if line.startswith("srarap: progress: ")]
+    summary = next(k for k, line in enumerate(lines) if line.startswith("srarap deform: "))
+    assert progress and warned < progress[0] and progress[-1] < summary == len(lines) - 1
+    assert any("coarse mesh, iteration" in lines[k] for k in progress)
+    assert any("full resolution, iteration" in lines[k] for k in progress)
+    assert sum("more than a full turn" in line for line in lines) == 1  # said once
+    quiet = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", spot, "h.yaml", "-o",
+                            "q.obj", "--multires", "1000", "-q"], cwd=tmp_path, text=True,
+                           capture_output=True, timeout=600,
+                           env={**os.environ, "SRARAP_PROGRESS_EVERY": "0.05"})
+    assert "progress" not in quiet.stderr and "more than a full turn" in quiet.stderr

@@ -156,6 +156,25 @@ def report(verbosity: int | None, *, warnings: Sequence[str] = (), details: Sequ
         say(summary)
 
 
+class EarlyWarnings:
+    """Says each warning as soon as the run knows it (a CI log shows a units mistake before
+    a long solve, not after it), once; :meth:`rest` gives the run's warnings not said yet,
+    for the closing :func:`report`."""
+
+    def __init__(self) -> None:
+        self.said: set[str] = set()
+
+    def __call__(self, warnings: Sequence[str]) -> None:
+        for text in dict.fromkeys(warnings):
+            if text not in self.said:
+                self.said.add(text)
+                say(f"srarap: warning: {text}")
+
+    def rest(self, warnings: Sequence[str]) -> list[str]:
+        """``warnings`` less those said already."""
+        return [w for w in warnings if w not in self.said]
+
+
 class FiniteFloat(click.FloatRange):
     """A float option's type: in its range and finite (Click's FloatRange lets NaN through
     every bound, and infinity through an open one)."""

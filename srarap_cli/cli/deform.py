@@ -1,6 +1,5 @@
 """``srarap deform``: mesh + handle file -> deformed mesh + energy log."""
 import math
-import sys
 from typing import Any
 
 import click
@@ -11,6 +10,7 @@ from ..solver.multires.size import AUTO_THRESHOLD
 from ..solver.stop import StopReason
 from ..tasks.job import DeformJob, JobStatus, run_job
 from .common import (
+    EarlyWarnings,
     MeshFormatType,
     cache_option,
     guarded,
@@ -69,13 +69,14 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
                     output_format=out_format, ascii=ascii, write_distortion=write_distortion,
                     log=log, preview=preview, preview_up=preview_up,
                     keep_unconverged=keep_unconverged, cache=cache, fps=fps, frame=frame)
-    progress = SolveProgress(enabled=verbosity != 0 and sys.stderr.isatty())
+    progress = SolveProgress(enabled=verbosity != 0)
+    early = EarlyWarnings()
     try:
-        done = run_job(job, callback=progress, write_stdout=write_stdout)
+        done = run_job(job, callback=progress, write_stdout=write_stdout, on_warnings=early)
     finally:
         progress.close()
     measured = memory.gigabytes(done.peaks)
-    report(verbosity, warnings=done.warnings,
+    report(verbosity, warnings=early.rest(done.warnings),
            details=done.solve.report_lines() + _cache_hint(done.solve, cache)
            + ([f"srarap: peak memory: {measured}"] if measured else []),
            summary=_summary(done.solve, done.settings,

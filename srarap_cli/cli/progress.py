@@ -1,37 +1,64 @@
-"""A one-line progress display for long solves, on a terminal only."""
+"""Progress of a long solve on stderr: a line redrawn in place on a terminal, a line every
+:data:`LOG_EVERY` seconds elsewhere (a CI log, ``make``, a file), so that a long run shows life
+and a hang can be told from work; ``-q`` silences both."""
+import os
 import sys
 import time
 from typing import Any
 
-#: Seconds before the line appears (short runs stay silent) and between redraws.
+#: Seconds before the terminal's line appears (short runs stay silent) and between redraws.
 DELAY, EVERY = 2.0, 0.2
+#: Seconds between lines on a stderr that is not a terminal (``SRARAP_PROGRESS_EVERY``)
+LOG_EVERY = 10.0
+ENV = "SRARAP_PROGRESS_EVERY"
+
+
+def log_interval() -> float:
+    """Seconds between progress lines in a log: ``$SRARAP_PROGRESS_EVERY`` where it is a
+    positive number, else :data:`LOG_EVERY`."""
+    try:
+        value = float(os.environ.get(ENV, ""))
+    except ValueError:
+        return LOG_EVERY
+    return value if value > 0 else LOG_EVERY
 
 
 class SolveProgress:
-    """Callback for a solve's log rows: iteration, energy, relative change, elapsed time.
+    """Callback for a solve's log rows: the level (a multiresolution solve's coarse mesh or
+    full resolution), iteration, energy, relative change, elapsed time.
 
-    Shown on stderr when it is a terminal, once the solve has run for :data:`DELAY` seconds;
-    ``close`` clears the line so the summary that follows starts clean.
+    Parameters
+    ----------
+    enabled : bool, show anything at all (not ``-q``)
+    terminal : bool, stderr is a terminal (default: asked of it)
     """
 
-    def __init__(self, enabled: bool) -> None:
+    def __init__(self, enabled: bool, terminal: bool | None = None) -> None:
         self.enabled = enabled
+        self.terminal = sys.stderr.isatty() if terminal is None else terminal
+        self.every = EVERY if self.terminal else log_interval()
+        self.delay = DELAY if self.terminal else self.every
         self.start = time.perf_counter()
         self.last = 0.0
         self.shown = False
+        self.levels = False  # a row named its level: the solve has a coarse mesh
 
     def __call__(self, row: dict[str, Any]) -> None:
         if not self.enabled:
             return
+        self.levels = self.levels or "level" in row
         now = time.perf_counter() - self.start
-        if now < DELAY or now - self.last < EVERY:
+        if now < self.delay or now - self.last < self.every:
             return
         self.last, self.shown = now, True
-        sys.stderr.write(f"\riteration {row['iteration']}  energy {row['total']:.6g}  "
-                         f"change {row['rel_change']:.2g}  {now:.1f} s ")
+        level = f"{row.get('level', 'full resolution')}, " if self.levels else ""
+        text = (f"{level}iteration {row['iteration']}  energy {row['total']:.6g}  "
+                f"change {row['rel_change']:.2g}  {now:.1f} s")
+        # on a terminal the line is cleared first: a shorter one left the longer one's tail
+        sys.stderr.write(f"\r\033[K{text}" if self.terminal else f"srarap: progress: {text}\n")
         sys.stderr.flush()
 
     def close(self) -> None:
-        if self.shown:
+        if self.shown and self.terminal:
             sys.stderr.write("\r\033[K")
             sys.stderr.flush()

@@ -82,19 +82,22 @@ class DeformJob:
 
 
 def run_job(job: DeformJob, callback: Callable[[dict], None] | None = None,
-            write_stdout: Callable[[bytes], None] | None = None) -> JobResult:
+            write_stdout: Callable[[bytes], None] | None = None,
+            on_warnings: Callable[[list[str]], None] | None = None) -> JobResult:
     """Run ``job``; raise on failure (InputError, OutputError, NumericalError, ...).
 
     ``callback`` receives each log row of the solve; ``write_stdout`` takes the mesh's bytes
-    when the output is ``-`` (before any file is committed). The result's ``status`` is
-    ``ok``, ``up-to-date``, ``not-converged`` or ``regressed``.
+    when the output is ``-`` (before any file is committed); ``on_warnings`` hears the
+    warnings known before the setup and before the solve, as they are known (the result
+    holds them all). The result's ``status`` is ``ok``, ``up-to-date``, ``not-converged``
+    or ``regressed``.
     """
     start = time.perf_counter()
     fmt = _preflight(job)
     key = _key(job) if job.record else None  # of the inputs as they were when the job began
     result = recorded_result(job, key) if key is not None else None
     if result is None:
-        result = _solve(job, fmt, callback, write_stdout, key)
+        result = _solve(job, fmt, callback, write_stdout, key, on_warnings)
     if job.expect is not None and result.status is not JobStatus.NOT_CONVERGED \
             and os.path.exists(job.output):
         check_golden(result, job.expect, job.output)
@@ -179,7 +182,7 @@ def recorded_result(job: DeformJob, key: str | None = None) -> JobResult | None:
                      else "inputs unchanged since the recorded run")
 
 
-def _solve(job, fmt, callback, write_stdout, key):
+def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
     peaks: dict[str, int | None] = {}
     peak = memory.start()
     source, source_format = read_any_mesh(job.mesh, job.input_format)
@@ -193,7 +196,7 @@ def _solve(job, fmt, callback, write_stdout, key):
     opts = resolve(constraints.solver, dict(job.settings))
     peak = memory.start()
     deformed, solve, notes = deform_mesh(source, constraints, opts, callback=callback,
-                                         cache=job.cache, name=name)
+                                         cache=job.cache, name=name, on_warnings=on_warnings)
     peaks["solve"], peak = memory.stop(peak), memory.start()
     if job.write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(

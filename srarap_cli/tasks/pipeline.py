@@ -87,24 +87,32 @@ def _labels(constraints, full_ids):
 
 def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = None,
                    handle_warnings: Sequence[str] = (),
-                   constraints: Constraints | None = None) -> tuple[Solver, list[str]]:
+                   constraints: Constraints | None = None,
+                   on_warnings: Callable[[list[str]], None] | None = None
+                   ) -> tuple[Solver, list[str]]:
     """The solver of ``p`` for a command (deform, animate) and the warnings of the handle
     file (``handle_warnings``), the mesh, the solver and, given ``constraints``, the parts
     they carry off rigidly (:mod:`.rigid_parts`); under ``opts.strict`` the first
     warning is raised instead (before the solver is built, where it can be). The mesh checks
     run before the solver is built, so their temporaries (edge tables of the whole mesh) do
     not add to the memory it holds (2M-vertex bar: peak 11.4 -> 10.6 GiB); once it is
-    built, the process keeps freed memory for reuse."""
+    built, the process keeps freed memory for reuse. ``on_warnings`` hears the warnings as
+    they are known, before the setup and before the solve (a log shows them before a long
+    run, not after it)."""
     notes = list(handle_warnings) + mesh_warnings(mesh.vertices, mesh.triangles()[0])
     if constraints is not None:
         notes += rigid_part_warnings(mesh.vertices, p.F if p.sub is None else
                                      solvable_faces(mesh.triangles()[0]), constraints)
     refuse_warnings(opts, notes)
+    if on_warnings is not None:
+        on_warnings(list(notes))
     deformer = make_deformer(p.V, p.F, p.ids, p.labels, settings=opts, area=p.area,
                              cache=cache)
     keep_freed_memory()  # after the setup, whose large arrays are allocated once
     notes += list(deformer.warnings)
     refuse_warnings(opts, notes)
+    if on_warnings is not None:
+        on_warnings(list(deformer.warnings))
     return deformer, notes
 
 
@@ -127,7 +135,8 @@ def scatter(mesh: Mesh, p: Problem, positions: np.ndarray, constraints: Constrai
 
 def deform_mesh(mesh: Mesh, constraints: Constraints, settings: Settings | None = None,
                 callback: Callable[[dict], None] | None = None, cache: str | None = None,
-                name: str = "mesh", **options: Any) -> tuple[Mesh, DeformResult, list[str]]:
+                name: str = "mesh", on_warnings: Callable[[list[str]], None] | None = None,
+                **options: Any) -> tuple[Mesh, DeformResult, list[str]]:
     """Deform a :class:`~srarap_cli.io.mesh.Mesh` by its :class:`~srarap_cli.io.handles.Constraints`.
 
     Parameters
@@ -140,6 +149,8 @@ def deform_mesh(mesh: Mesh, constraints: Constraints, settings: Settings | None 
     callback : callable(dict), optional, receives each log row
     cache : str, optional, folder for multiresolution coarse meshes
     name : str, the mesh's file, for error messages
+    on_warnings : callable(list of str), optional, hears the warnings known before the
+        setup and before the solve, as they are known (all of them are returned too)
     **options : solver settings by name, over ``settings``
 
     Returns
@@ -152,7 +163,7 @@ def deform_mesh(mesh: Mesh, constraints: Constraints, settings: Settings | None 
                              "deform_mesh")
     p = problem(mesh, constraints, name)
     deformer, notes = command_solver(mesh, p, settings, cache, constraints.warnings,
-                                     constraints)
+                                     constraints, on_warnings)
     sub_result = deformer.solve(p.targets, callback=callback)
     positions = scatter(mesh, p, sub_result.positions, constraints)
     rotors = np.tile(IDENTITY, (len(positions), 1))

@@ -58,6 +58,14 @@ class _Delayed:
         return self.correction(state, residual)
 
 
+def _on_level(callback, level):
+    """``callback`` given each row with its ``level`` too (a progress line says which mesh
+    the iterations are on: they start again from 0 at full resolution)."""
+    if callback is None:
+        return None
+    return lambda row: callback({**row, "level": level})
+
+
 def _all_iterations(result):
     """Every iteration ``result`` ran, on every level."""
     return result.iterations + result.coarse_iterations
@@ -297,7 +305,8 @@ class MultiresDeformer:
         peak = memory.start()
         try:
             coarse = self.coarse_deformer.solve(targets[self._coarse_slots], initial=warm,
-                                                callback=callback, settings=s, start=start)
+                                                callback=_on_level(callback, "coarse mesh"),
+                                                settings=s, start=start)
         except Exception:
             self._settle()
             raise
