@@ -169,3 +169,32 @@ def test_the_up_guess_falls_back_to_y_when_the_extents_do_not_tell():
     strays = np.vstack([bar.vertices, [[40.0, 0, 5], [-40.0, 0, 5]]])
     F = np.vstack([bar.triangles()[0], [[658, 0, 659]]])
     assert up_axis(Mesh.from_arrays(strays, F)) == "z"
+
+
+@pytest.mark.parametrize("turn", ["angle_deg: 10", "angle_rad: 30"])
+def test_the_dry_run_warns_what_deform_warns_on_a_mesh_of_several_parts(tmp_path, turn):
+    """Issue 60: ``info MESH HANDLES`` listed no warning where ``deform`` then warned of a
+    part carried off rigidly and a part nothing holds. Three tubes: one bent by its handles,
+    one moved whole by a group, one held by nothing; ``info --json`` (its warnings and the
+    mesh's problems) says exactly what ``deform`` says."""
+    from helpers import run_cli, tube
+
+    V, F = tube(length=6.0, rings=8, segments=6)
+    W = np.vstack([V, V + [5.0, 0, 0], V + [10.0, 0, 0]])
+    G = np.vstack([F, F + len(V), F + 2 * len(V), F[:1]])  # and one face twice
+    write_mesh(str(tmp_path / "m.obj"), Mesh.from_arrays(W, G))
+    (tmp_path / "h.yaml").write_text(
+        "groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
+        "  top: {box: {min: [-2, -2, 5.99], max: [2, 2, 6.01]}, rotate: {axis: [0, 0, 1], "
+        f"{turn}}}}}\n  whole: {{box: {{min: [3, -2, -1], max: [7, 2, 7]}}, "
+        "translate: [0, 0, 1]}\n")
+    dry = run_cli(["info", "m.obj", "h.yaml", "--json"], cwd=tmp_path)
+    assert dry.returncode == 0, dry.stderr
+    doc = json.loads(dry.stdout)
+    wet = run_cli(["deform", "m.obj", "h.yaml", "-o", "o.obj"], cwd=tmp_path)
+    assert wet.returncode == 0, wet.stderr
+    said = {line[len("srarap: warning: "):] for line in wet.stderr.splitlines()
+            if line.startswith("srarap: warning: ")}
+    assert said == set(doc["warnings"]) | set(doc["problems"])
+    assert any("move each rigidly" in w for w in said)
+    assert any("without a constrained vertex" in w for w in said)

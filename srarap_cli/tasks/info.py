@@ -9,7 +9,8 @@ from ..io.mesh import Mesh
 from ..solver.group_rotations import group_rotors
 from ..solver.mesh_checks import edge_adjacency, edge_counts, mesh_warnings
 from ..solver.quaternion import to_matrix
-from .pipeline import problem
+from ..solver.settings import resolve
+from .pipeline import model_warnings, problem, request_warnings
 
 AXES = "xyz"
 
@@ -55,10 +56,13 @@ def mesh_info(mesh: Mesh) -> dict:
 def handles_info(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> dict:
     """Per group of ``constraints``: vertices selected, the action in words, overlaps; the
     region's size and how many vertices are free; ``warnings``, what deform would warn about
-    the file (an angle's unit, a motion beyond the mesh's size). Runs the checks a solve
-    would (a dry run).
+    the file and the request (an angle's unit, a motion beyond the mesh's size, parts carried
+    off rigidly or held by nothing, edge weights), from the functions deform calls. Runs the
+    checks a solve would (a dry run); the mesh's own problems are :func:`mesh_info`'s.
     """
     p = problem(mesh, constraints, name)  # the same validation as deform
+    said = (list(constraints.warnings) + request_warnings(mesh, p, constraints)
+            + model_warnings(p, resolve(constraints.solver)))
     slots = {g: np.searchsorted(constraints.ids, ids) for g, ids in constraints.groups.items()}
     groups = []
     for g, ids in constraints.groups.items():
@@ -75,7 +79,7 @@ def handles_info(mesh: Mesh, constraints: Constraints, name: str = "mesh") -> di
     return {"groups": groups, "overlaps": _overlaps(constraints.groups, n),
             "constrained": int(constraints.ids.size), "region": region,
             "free": int(len(p.V) - p.ids.size), "of": n,
-            "warnings": list(constraints.warnings)}
+            "warnings": list(dict.fromkeys(said))}
 
 
 def describe_motion(rest: np.ndarray, targets: np.ndarray) -> str:

@@ -9,10 +9,11 @@ from ..io.handles import Constraints
 from ..io.mesh import Mesh
 from ..runtime.allocator import keep_freed_memory
 from ..runtime.errors import InputError
+from ..solver.deformer import unanchored, weight_warnings
 from ..solver.interface import Solver
 from ..solver.mesh_checks import geometry_problem, mesh_warnings, solvable_faces
 from ..solver.oneshot import make_deformer
-from ..solver.operators import mesh_area
+from ..solver.operators import cell_graph, mesh_area
 from ..solver.quaternion import IDENTITY
 from ..solver.region import restrict
 from ..solver.result import DeformResult
@@ -101,8 +102,7 @@ def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = N
     run, not after it)."""
     notes = list(handle_warnings) + mesh_warnings(mesh.vertices, mesh.triangles()[0])
     if constraints is not None:
-        notes += rigid_part_warnings(mesh.vertices, p.F if p.sub is None else
-                                     solvable_faces(mesh.triangles()[0]), constraints)
+        notes += request_warnings(mesh, p, constraints)
     refuse_warnings(opts, notes)
     if on_warnings is not None:
         on_warnings(list(notes))
@@ -114,6 +114,23 @@ def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = N
     if on_warnings is not None:
         on_warnings(list(deformer.warnings))
     return deformer, notes
+
+
+def request_warnings(mesh: Mesh, p: Problem, constraints: Constraints) -> list[str]:
+    """What the handles ask that deserves a word before a solve: connected parts they carry
+    off rigidly (:mod:`.rigid_parts`). ``srarap info`` says the same."""
+    return rigid_part_warnings(mesh.vertices, p.F if p.sub is None else
+                               solvable_faces(mesh.triangles()[0]), constraints)
+
+
+def model_warnings(p: Problem, opts: Settings) -> list[str]:
+    """What the solver will say of the problem's mesh and held vertices (edge weights, parts
+    nothing holds), without building it: the same functions its setup calls, for ``srarap
+    info``'s dry run. (A multiresolution solve adds its simplification's notes.)"""
+    graph = cell_graph(p.V, p.F, opts.weights)
+    held = np.zeros(len(p.V), dtype=bool)
+    held[p.ids] = True
+    return weight_warnings(graph) + unanchored(graph, held)[1]
 
 
 def refuse_warnings(opts: Settings, warnings: Sequence[str]) -> None:
