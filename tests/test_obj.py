@@ -32,8 +32,8 @@ def reference_obj(mesh):
         later.setdefault(k, []).append(s + "\n")
     out = ["# written by srarap\n", *later.get(0, [])]
     out += ["v " + " ".join(map(number, p)) + "\n" for p in mesh.vertices]
-    if mesh.uv is not None:
-        out += ["vt " + " ".join(map(number, p)) + "\n" for p in mesh.uv]
+    if mesh.uv is not None:  # texture coordinates in their shortest exact text
+        out += ["vt " + " ".join(repr(float(x)) for x in p) + "\n" for p in mesh.uv]
     if mesh.normals is not None:
         out += ["vn " + " ".join(map(number, p)) + "\n" for p in mesh.normals]
     corner = 0
@@ -178,3 +178,29 @@ def test_animation_frames_are_the_files_format_obj_writes(kind):
         assert frame(moved) == reference_obj(expected).encode("utf-8")
         assert kind != "normals and statements" or not np.allclose(expected.normals,
                                                                     spot.normals)
+
+
+@pytest.mark.parametrize("faces, what", [("f 1/1 2/2 3/3\n", "vt"), ("f 1//1 2//1 3//1\n", "vn"),
+                                         ("f 1/1/1 2/2/1 3/3/1\n", "vt")])
+def test_references_to_entries_a_file_has_none_of_are_refused(tmp_path, faces, what):
+    """Issue 60: faces naming ``vt`` entries in a file without ``vt`` lines were accepted
+    (and written back as an invalid OBJ), while one index past the last entry was refused."""
+    path = tmp_path / "m.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\n" + ("vn 0 0 1\n" if what == "vt" else "")
+                    + faces)
+    with pytest.raises(InputError, match=f"'{what}' entry that does not exist"):
+        read_mesh(str(path))
+
+
+def test_texture_coordinates_are_written_back_with_the_digits_read(tmp_path):
+    """Issue 60: ``0.902657`` came back as ``0.90265700000000004``; each number is now the
+    shortest text that reads back as the same float, so the digits read when they were."""
+    path = tmp_path / "m.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.902657 0.5\nvt 0.1 1e-20\nvt 0.3 0.7\n"
+                    "f 1/1 2/2 3/3\n")
+    mesh = read_mesh(str(path))
+    text = obj.format_obj(mesh)
+    assert "vt 0.902657 0.5\nvt 0.1 1e-20\nvt 0.3 0.7\n" in text
+    again = tmp_path / "again.obj"
+    again.write_text(text)
+    assert np.array_equal(read_mesh(str(again)).uv, mesh.uv)

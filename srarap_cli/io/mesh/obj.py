@@ -73,6 +73,8 @@ def _read_bulk(text):
         return None
     mesh = Mesh(vertices=V, face_sizes=sizes, face_vertices=corners[0] - 1,
                 statements=statements)
+    if (corners[1] is not None and not uvs[1]) or (corners[2] is not None and not norms[1]):
+        return None  # references to entries the file lacks: the general reader says so
     if corners[1] is not None and uvs[1]:
         mesh.uv, mesh.face_uv = _rows_of(*uvs, 2), corners[1] - 1
     if corners[2] is not None and norms[1]:
@@ -185,6 +187,10 @@ def _read_general(text, path):
     c = _face_corners(faces, path)
     mesh = Mesh(vertices=V, face_sizes=np.array(sizes, dtype=np.int64),
                 face_vertices=c[:, 0].copy(), statements=statements)
+    for refs, rows, what in ((c[:, 1], uvs, "vt"), (c[:, 2], norms, "vn")):
+        if not rows and (refs >= 0).any():  # as invalid as an index past the last entry
+            raise InputError(f"{path}: face references a '{what}' entry that does not exist "
+                             f"(the file has no '{what}' lines)")
     if uvs and (c[:, 1] >= 0).any():
         width = 3 if all(len(r) >= 3 for r in uvs) else 2
         mesh.uv, mesh.face_uv = _floats(uvs, width, path, "vt"), c[:, 1].copy()
@@ -280,7 +286,13 @@ def _vertex_lines(mesh):
 
 
 def _uv_lines(mesh):
-    return "" if mesh.uv is None else _rows("vt" + " %.17g" * mesh.uv.shape[1] + "\n", mesh.uv)
+    """The ``vt`` lines: each number in the shortest text that reads back as the same float
+    (``0.902657`` as read, not ``0.90265700000000004``): texture coordinates come from the
+    input unchanged, and that is the text they were read from whenever it was that short."""
+    if mesh.uv is None or len(mesh.uv) == 0:
+        return ""
+    fmt = "vt" + " %r" * mesh.uv.shape[1] + "\n"
+    return (fmt * len(mesh.uv)) % tuple(np.asarray(mesh.uv, dtype=float).ravel().tolist())
 
 
 def _normal_lines(mesh):
