@@ -450,3 +450,34 @@ def test_an_animation_run_again_with_fewer_frames_leaves_only_its_own(tmp_path, 
     assert again.returncode == 0, again.stderr
     assert sorted(os.listdir(tmp_path / "fr")) == ["f_00.obj", "f_01.obj", "f_02.obj"]
     assert "removed 3 later frame(s) of an earlier run" in again.stderr
+
+
+def test_batch_strict_makes_every_jobs_warnings_errors(tmp_path):
+    """Issue 60: the README's ``--strict`` for a batch exited 2 "No such option"."""
+    handles = tmp_path / "h.yaml"
+    handles.write_text(open(TWIST).read().replace("angle_deg: 90", "angle_rad: 30"))
+    manifest = tmp_path / "m.yaml"
+    manifest.write_text(yaml.safe_dump({"jobs": [
+        {"name": "j", "mesh": BAR, "handles": str(handles), "output": "x.obj"}]}))
+    assert run_cli(["batch", manifest, "-o", tmp_path / "lax", "-q"]).returncode == 0
+    strict = run_cli(["batch", manifest, "-o", tmp_path / "strict", "-q", "--strict"])
+    assert strict.returncode == 8
+    row = json.loads((tmp_path / "strict" / "summary.json").read_text())[0]
+    assert row["status"] == "failed" and row["exit_code"] == 4 and "strict" in row["message"]
+    assert not (tmp_path / "strict" / "x.obj").exists()
+
+
+def test_a_relative_distance_says_its_unit(tmp_path):
+    """Issue 60: with ``relative: true`` the message gave a fraction of the diagonal as if it
+    were a length."""
+    out = tmp_path / "out"
+    manifest = tmp_path / "m.yaml"
+    golden = tmp_path / "golden.obj"
+    golden.write_bytes(open(BAR, "rb").read())  # the rest shape: far from the twisted one
+    manifest.write_text(yaml.safe_dump({"jobs": [
+        {"name": "j", "mesh": BAR, "handles": TWIST, "output": "x.obj",
+         "expect": {"golden": str(golden), "tol": 1e-6, "relative": True}}]}))
+    assert run_cli(["batch", manifest, "-o", out, "-q"]).returncode == 8
+    row = json.loads((out / "summary.json").read_text())[0]
+    assert row["status"] == "regressed" and "fractions of the golden mesh's diagonal" in \
+        row["message"]

@@ -44,10 +44,14 @@ SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
 @click.option("--threads", type=click.IntRange(min=1), metavar="N",
               help="Threads for each job's solve, at most the CPUs divided by --workers. "
               "[default: $SRARAP_THREADS, else the CPUs divided by --workers]")
+@click.option("--strict", is_flag=True,
+              help="Every job's warnings are errors (as strict: true in the manifest's "
+              "defaults): the job fails with exit code 4 in its row.")
 @click.option("-q", "--quiet", is_flag=True, help="No summary table.")
 @guarded
 def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unconverged: bool,
-          report: str | None, junit: str | None, threads: int | None, quiet: bool) -> None:
+          report: str | None, junit: str | None, threads: int | None, strict: bool,
+          quiet: bool) -> None:
     """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
 
     Exit code 0 when every job is ok or up to date, 8 when any job failed or regressed
@@ -63,6 +67,9 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     if junit is not None:
         check_output_path(junit, (".xml",), "--junit")
     jobs = load_manifest(manifest)
+    if strict:  # over the manifest's defaults and each job's settings, as deform's flag
+        for job in jobs:
+            job["settings"] = {**job["settings"], "strict": True}
     check_outputs(jobs, out, manifest)
     try:
         os.makedirs(out, exist_ok=True)

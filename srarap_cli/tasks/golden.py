@@ -23,6 +23,8 @@ def check_golden(result: JobResult, expect: Mapping[str, Any], out: str) -> None
         at = "" if far is None else (f" at vertex {far['vertex']} of the "
                                      f"{'golden' if far['mesh'] == 'a' else 'output'} mesh")
         result.status, result.exit_code = JobStatus.REGRESSED, JobStatus.REGRESSED.exit_code
-        result.message = (f"max distance {result.compare_max:.3g} > tol {expect['tol']:g}{at}; "
+        unit = " (fractions of the golden mesh's diagonal)" if scale != 1.0 else ""
+        result.message = (f"max distance {result.compare_max:.3g} > tol {expect['tol']:g}"
+                          f"{unit}{at}; "
                           f"{100 * beyond(figures, expect['tol'], expect['relative']):.3g}% "
                           "of the vertices beyond tol")
