@@ -37,7 +37,7 @@ def test_a_format_writes_and_reads_back_exactly(name, faces, tmp_path, capsys):
     assert [w for w in lost if "per-vertex" in w] == ([] if keeps else [
         f"per-vertex data (weight) not written: {TABLE[name].display} keeps positions and "
         "faces; write .vtu to keep it"])
-    assert ["polygons of more than 3 corners written as triangles" in w for w in lost].count(
+    assert ["quads and larger polygons written as triangles" in w for w in lost].count(
         True) == split
     back = read_mesh(path)
     assert np.array_equal(back.vertices, mesh.vertices)
@@ -143,3 +143,37 @@ def test_a_two_part_extension_names_its_format():
     assert by_extension("out/Part.VOL.GZ").name == "netgen-gz"
     assert by_extension("part.vol").name == "netgen" and by_extension("notes.gz") is None
     assert suffix_of("a.b/c.post.gz") == ".post.gz" and suffix_of("a.b/c") == ""
+
+
+@pytest.mark.parametrize("name", ["vtu", "vtk", "gmsh", "xdmf"])
+def test_what_a_format_drops_is_said(name, tmp_path):
+    """Issue 60: an OBJ's texture coordinates and normals went to .vtu, .vtk, .msh and .xdmf
+    without a word (OFF, PLY and STL said it), so --strict could not catch it."""
+    from helpers import tube_mesh
+
+    mesh = tube_mesh(rings=4, segments=6)  # quads and triangle fans, with texture coordinates
+    mesh.normals, mesh.face_normals = np.tile([0.0, 0.0, 1.0], (1, 1)), \
+        np.zeros(len(mesh.face_vertices), dtype=np.int64)
+    lost = write_mesh(tmp_path / f"m{FORMATS[name].extension}", mesh)
+    assert any(w.startswith("texture coordinates not written") for w in lost), lost
+    assert any(w.startswith("normals not written") for w in lost), lost
+
+
+@pytest.mark.parametrize("name", ["vtu", "gmsh"])
+def test_one_pentagon_among_quads_splits_only_itself(name, tmp_path):
+    """Issue 60: one pentagon turned every quad into two triangles, while the warning named
+    only the large polygons."""
+    side = 6
+    grid = np.array([[x, y, 0.0] for y in range(side) for x in range(side)])
+    quads = [[y * side + x, y * side + x + 1, (y + 1) * side + x + 1, (y + 1) * side + x]
+             for y in range(side - 1) for x in range(side - 1)]
+    quads[0] = [0, 1, 7, 6]
+    extra = np.vstack([grid, [[0.5, -0.5, 0.0]]])  # a pentagon in place of the first quad
+    faces = [[0, len(grid), 1, 7, 6]] + quads[1:]
+    mesh = Mesh(vertices=extra, face_sizes=np.array([len(f) for f in faces]),
+                face_vertices=np.concatenate(faces))
+    lost = write_mesh(tmp_path / f"m{FORMATS[name].extension}", mesh)
+    assert lost == ["1 polygons of more than 4 corners written as triangles (the format keeps "
+                    "triangles and quads)"]
+    back = read_mesh(tmp_path / f"m{FORMATS[name].extension}")
+    assert (back.face_sizes == 4).sum() == len(quads) - 1 and (back.face_sizes == 3).sum() == 3

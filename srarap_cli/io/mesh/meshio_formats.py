@@ -232,6 +232,10 @@ def _writer(name, spec):
         import meshio
 
         cells, lost = _cells(mesh, spec.quads)
+        lost += [f"{what} not written: {spec.display} keeps positions, faces and point data; "
+                 "write .obj to keep them" for what, kept in
+                 (("texture coordinates", mesh.uv), ("normals", mesh.normals))
+                 if kept is not None]
         data = {k: np.asarray(v) for k, v in mesh.vertex_data.items()} if spec.keeps_data else {}
         if mesh.vertex_data and not spec.keeps_data:
             lost.append(f"per-vertex data ({', '.join(sorted(mesh.vertex_data))}) not written: "
@@ -251,21 +255,35 @@ def _writer(name, spec):
 
 
 def _cells(mesh, quads=True):
-    """Triangles, then quads (a mixed mesh's faces come back in that order); larger
-    polygons, and quads where the format keeps none, split into triangles, with a warning."""
+    """Triangles, then quads (a mixed mesh's faces come back in that order); the larger
+    polygons alone, and quads where the format keeps none, split into triangles (a fan from
+    each one's first corner, after the mesh's own triangles), with a warning that counts
+    them: one pentagon among quads turned every quad into two triangles."""
     sizes, lost = mesh.face_sizes, []
-    if (sizes > (4 if quads else 3)).any():
-        lost.append(f"polygons of more than {4 if quads else 3} corners written as triangles")
-        tris = mesh.triangles()[0]
-        return [("triangle", tris)], lost
+    largest = 4 if quads else 3
     offsets = np.concatenate([[0], np.cumsum(sizes)])
+    split = np.flatnonzero(sizes > largest)
+    triangles = [_faces_of(mesh, offsets, np.flatnonzero(sizes == 3), 3)]
+    for size in np.unique(sizes[split]):
+        rows = split[sizes[split] == size]
+        corners = _faces_of(mesh, offsets, rows, int(size))
+        triangles += [corners[:, [0, k, k + 1]] for k in range(1, int(size) - 1)]
+    if split.size:
+        kind = "polygons of more than 4 corners" if quads else "quads and larger polygons"
+        lost.append(f"{split.size} {kind} written as triangles (the format keeps "
+                    f"{'triangles and quads' if quads else 'triangles'})")
     cells = []
-    for size, kind in ((3, "triangle"), (4, "quad")):
-        rows = np.flatnonzero(sizes == size)
-        if rows.size:
-            idx = offsets[rows][:, None] + np.arange(size)
-            cells.append((kind, mesh.face_vertices[idx]))
+    tris = np.concatenate(triangles) if len(triangles) > 1 else triangles[0]
+    if len(tris):
+        cells.append(("triangle", tris))
+    if quads and (sizes == 4).any():
+        cells.append(("quad", _faces_of(mesh, offsets, np.flatnonzero(sizes == 4), 4)))
     return cells, lost
+
+
+def _faces_of(mesh, offsets, rows, size):
+    """(len(rows), size) corners of the faces ``rows``, all of ``size`` corners."""
+    return mesh.face_vertices[offsets[rows][:, None] + np.arange(size)].reshape(-1, size)
 
 
 def markdown_table() -> str:
