@@ -481,3 +481,20 @@ def test_a_relative_distance_says_its_unit(tmp_path):
     row = json.loads((out / "summary.json").read_text())[0]
     assert row["status"] == "regressed" and "fractions of the golden mesh's diagonal" in \
         row["message"]
+
+
+def test_a_strict_failure_names_every_warning_that_failed_it(tmp_path):
+    """Issue 60: a strict failure named only the first warning: one round trip per warning."""
+    handles = tmp_path / "h.yaml"
+    handles.write_text(
+        "groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
+        "  top: {box: {min: [-2, -2, 9.99], max: [2, 2, 10.01]}, rotate: {axis: [0, 0, 1], "
+        "angle_rad: 30}}\n  mid: {box: {min: [-2, -2, 4.99], max: [2, 2, 5.01]}, "
+        "translate: [0, 0, 500]}\n")
+    lax = run_cli(["deform", BAR, handles, "-o", tmp_path / "lax.obj", "--max-iter", "3",
+                   "--keep-unconverged"])
+    warned = [line for line in lax.stderr.splitlines() if line.startswith("srarap: warning:")]
+    assert len(warned) == 2, lax.stderr
+    said = one_line(run_cli(["deform", BAR, handles, "-o", tmp_path / "o.obj", "--strict"]), 4)
+    assert all(w[len("srarap: warning: "):] in said for w in warned), said
+    assert "(and 1 more: " in said and not (tmp_path / "o.obj").exists()

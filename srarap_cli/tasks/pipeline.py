@@ -134,9 +134,12 @@ def model_warnings(p: Problem, opts: Settings) -> list[str]:
 
 
 def refuse_warnings(opts: Settings, warnings: Sequence[str]) -> None:
-    """Under ``strict``, the first of ``warnings`` as an :class:`InputError` (exit 4)."""
+    """Under ``strict``, ``warnings`` as an :class:`InputError` (exit 4): every one of them
+    in its line, so that one run shows all there is to mend (it named only the first)."""
     if opts.strict and warnings:
-        raise InputError(f"{warnings[0]} (strict: warnings are errors)")
+        said = list(dict.fromkeys(warnings))
+        more = f" (and {len(said) - 1} more: {'; '.join(said[1:])})" if len(said) > 1 else ""
+        raise InputError(f"{said[0]}{more} (strict: warnings are errors)")
 
 
 def scatter(mesh: Mesh, p: Problem, positions: np.ndarray, constraints: Constraints,
