@@ -498,3 +498,18 @@ def test_a_strict_failure_names_every_warning_that_failed_it(tmp_path):
     said = one_line(run_cli(["deform", BAR, handles, "-o", tmp_path / "o.obj", "--strict"]), 4)
     assert all(w[len("srarap: warning: "):] in said for w in warned), said
     assert "(and 1 more: " in said and not (tmp_path / "o.obj").exists()
+
+
+def test_a_job_whose_output_was_deleted_runs_again(tmp_path):
+    """Issue 62: a job whose output was deleted after an ok run could have been reported
+    ``up-to-date`` from its record alone without a test noticing."""
+    manifest = _manifest(tmp_path, ["x.obj"])
+    out = tmp_path / "out"
+    assert run_cli(["batch", manifest, "-o", out, "-q"]).returncode == 0
+    assert run_cli(["batch", manifest, "-o", out, "-q"]).returncode == 0
+    assert json.loads((out / "summary.json").read_text())[0]["status"] == "up-to-date"
+    first = (out / "x.obj").read_bytes()
+    (out / "x.obj").unlink()
+    assert run_cli(["batch", manifest, "-o", out, "-q"]).returncode == 0
+    assert json.loads((out / "summary.json").read_text())[0]["status"] == "ok"
+    assert (out / "x.obj").read_bytes() == first

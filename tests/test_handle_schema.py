@@ -78,3 +78,23 @@ def test_several_boxes_and_spheres_select_their_union():
     jsonschema.validate(doc, handle_schema())
     c = parse_handles(doc, V)
     assert c.groups["g"].tolist() == [0, 3] and c.groups["h"].tolist() == [1, 2]
+
+
+@pytest.mark.parametrize("action", ["fixed", "translate", "rotate", "matrix"])
+def test_keyframes_beside_a_static_action_are_refused_by_the_schema_and_the_parser(action):
+    """Issue 62: the published schema accepted ``keyframes`` with ``fixed`` (and the other
+    static actions), a document the parser refuses."""
+    from srarap_cli.io.handles.keys import STATIC_ACTIONS
+
+    assert action in STATIC_ACTIONS
+    value = {"fixed": True, "translate": [0, 0, 1], "rotate": {"axis": [0, 0, 1], "angle_deg": 9},
+             "matrix": np.eye(4).tolist()}[action]
+    doc = {"groups": {"top": {"indices": [1], action: value,
+                              "keyframes": [{"frame": 0}, {"frame": 4, "translate": [0, 0, 1]}]}}}
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(doc, handle_schema())
+    with pytest.raises(InputError, match=f"keyframes cannot be combined with {action}"):
+        parse_handles(doc, np.zeros((4, 3)), fps=24)
+    del doc["groups"]["top"][action]
+    jsonschema.validate(doc, handle_schema())  # without it, both take the document
+    parse_handles(doc, np.zeros((4, 3)), fps=24)

@@ -11,7 +11,7 @@ from typing import Any
 
 from ...solver.settings import SETTINGS
 from .keyframes import EASINGS
-from .keys import KEY_KEYS
+from .keys import KEY_KEYS, STATIC_ACTIONS
 from .selectors import SELECTOR_KEYS
 from .transforms import ACTION_KEYS, ANGLE_KEYS, QUATERNION_KEYS
 
@@ -96,7 +96,10 @@ def handle_schema() -> dict:
              "properties": {**_selectors(), **_actions(),
                             "keyframes": {"type": "array", "items": _keyframe(), "minItems": 1},
                             "easing": {"enum": sorted(EASINGS)}},
-             "anyOf": [{"required": [k]} for k in SELECTOR_KEYS]}
+             "anyOf": [{"required": [k]} for k in SELECTOR_KEYS],
+             # keyframes hold the motion: no static action beside them (the parser's rule)
+             "if": {"required": ["keyframes"]},
+             "then": {"not": {"anyOf": [{"required": [k]} for k in STATIC_ACTIONS]}}}
     region = {"type": "object", "additionalProperties": False, "properties": _selectors(),
               "anyOf": [{"required": [k]} for k in SELECTOR_KEYS]}
     return {"$schema": "https://json-schema.org/draft/2020-12/schema",
