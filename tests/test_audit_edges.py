@@ -435,6 +435,7 @@ def test_the_report_escapes_every_field_of_a_row():
     page = report_html([row], {"j<b>": {}}, "t<t>")
     assert "<script>" not in page and "<i>" not in page and "<w>" not in page
     assert "&lt;script&gt;" in page
+    assert '<span class="seconds">' in page  # the report's own markup stays markup
 
 
 @pytest.mark.parametrize("resume", [False, True])

@@ -69,7 +69,7 @@ def _summary(rows):
 def _job(row, pictures):
     status = row.status.value
     numbers = [("exit code", _number(row.exit_code, "d")),
-               ("stop", row.stop or "-"),
+               ("stop", html.escape(row.stop or "-")),  # from a record: text, not markup
                ("iterations", _number(row.iterations, "d")),
                ("seconds", _seconds(row.seconds)),
                ("energy", _number(row.energy, ".6g")),
@@ -78,7 +78,7 @@ def _job(row, pictures):
                ("tolerance", _number(row.tol, "g")),
                ("warnings", str(len(row.warnings)))]
     table = ("<tr>" + "".join(f"<th>{k}</th>" for k, _ in numbers) + "</tr><tr>"
-             + "".join(f"<td>{html.escape(v)}</td>" for _, v in numbers) + "</tr>")
+             + "".join(f"<td>{v}</td>" for _, v in numbers) + "</tr>")
     figures = "".join(
         f"<figure><img alt=\"{html.escape(caption)}\" src=\"data:image/png;base64,"
         f"{pictures[key]}\"><figcaption>{html.escape(caption)}</figcaption></figure>"
