@@ -105,6 +105,19 @@ class CellGraph:
         return sums.reshape((self.n,) + values.shape[1:])
 
 
+def row_views(A: sp.csr_matrix) -> list[tuple[slice, sp.csr_matrix]]:
+    """``A``'s :func:`~srarap_cli.runtime.parallel.row_blocks` with their rows of ``A``,
+    which share its values and indices (no copy)."""
+    out = []
+    for rows in row_blocks(A.shape[0]):
+        lo, hi = int(A.indptr[rows.start]), int(A.indptr[rows.stop])
+        out.append((rows, sp.csr_matrix((A.data[lo:hi], A.indices[lo:hi],
+                                         A.indptr[rows.start:rows.stop + 1] - lo),
+                                        shape=(rows.stop - rows.start, A.shape[1]),
+                                        copy=False)))
+    return out
+
+
 def mesh_area(V: np.ndarray, F: np.ndarray) -> float:
     """Total surface area of a triangle mesh (zero-area faces count 0)."""
     return float(np.nansum(igl.doublearea(V, F)) / 2.0)

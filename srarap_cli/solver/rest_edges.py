@@ -3,8 +3,8 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ..runtime.parallel import map_blocks, row_blocks
-from .operators import CellGraph
+from ..runtime.parallel import map_blocks
+from .operators import CellGraph, row_views
 from .quaternion import to_matrix
 
 
@@ -43,21 +43,13 @@ class RestEdges:
         order = np.lexsort((cols, rows))
         indices = _int32(cols[order])
         indptr = _int32(np.concatenate([[0], np.cumsum(graph.degree + 1)]))
-        self._values = [np.concatenate([c * q[:, b], -self.sum_cq[:, b]])[order]
-                        for b in range(3)]
-        self._pattern = indices, indptr
-        self._blocks = [(rows, [self._rows(b, rows) for b in range(3)])
-                        for rows in row_blocks(n)]
+        matrices = [sp.csr_matrix((np.concatenate([c * q[:, b], -self.sum_cq[:, b]])[order],
+                                   indices, indptr), shape=(n, n), copy=False)
+                    for b in range(3)]
+        views = [row_views(matrix) for matrix in matrices]
+        self._blocks = [(rows, [v[k][1] for v in views]) for k, (rows, _) in enumerate(views[0])]
         self._half: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._rest_total = float(self.rest_scale.sum())
-
-    def _rows(self, b: int, rows: slice) -> sp.csr_matrix:
-        """Rows ``rows`` of covariance matrix ``b`` (views of its values and indices)."""
-        indices, indptr = self._pattern
-        lo, hi = int(indptr[rows.start]), int(indptr[rows.stop])
-        return sp.csr_matrix((self._values[b][lo:hi], indices[lo:hi],
-                              indptr[rows.start:rows.stop + 1] - lo),
-                             shape=(rows.stop - rows.start, self.graph.n), copy=False)
 
     @property
     def q(self) -> np.ndarray:

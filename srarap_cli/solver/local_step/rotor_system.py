@@ -35,6 +35,7 @@ from scipy.sparse import csr_matrix
 
 from ...runtime.parallel import by_rows, map_blocks, row_blocks
 from ..linalg import factor
+from ..operators import row_views
 from ..quaternion import normalize
 from ..rest_edges import RestEdges
 from .block_cg import conjugate_gradients
@@ -171,7 +172,7 @@ class FreeRotorMatrix(spla.LinearOperator):
     def __init__(self, D: np.ndarray, W: csr_matrix,
                  blocks: list[tuple[slice, csr_matrix]] | None = None) -> None:
         super().__init__(dtype=float, shape=(4 * D.shape[0],) * 2)
-        self.D, self.W = D, sp.csr_matrix(W)
+        self.D, self.W = D, W if sp.isspmatrix_csr(W) else sp.csr_matrix(W)
         self._blocks = row_views(self.W) if blocks is None else blocks
 
     def _matvec(self, v):
@@ -202,18 +203,6 @@ class FreeRotorMatrix(spla.LinearOperator):
         nf = self.D.shape[0]
         blocks = sp.bsr_matrix((self.D, np.arange(nf), np.arange(nf + 1)), shape=self.shape)
         return (blocks - sp.kron(self.W, sp.identity(4))).tocsr()
-
-
-def row_views(A: csr_matrix) -> list[tuple[slice, csr_matrix]]:
-    """``A``'s :func:`~srarap_cli.runtime.parallel.row_blocks` with their rows of ``A``,
-    which share its values and indices (no copy)."""
-    out = []
-    for rows in row_blocks(A.shape[0]):
-        lo, hi = int(A.indptr[rows.start]), int(A.indptr[rows.stop])
-        out.append((rows, csr_matrix((A.data[lo:hi], A.indices[lo:hi],
-                                      A.indptr[rows.start:rows.stop + 1] - lo),
-                                     shape=(rows.stop - rows.start, A.shape[1]), copy=False)))
-    return out
 
 
 def _int32(A):
