@@ -5,9 +5,15 @@ The command-line reference's Default column:
 mkdocs-click prints Click's ``Sentinel.UNSET`` for an option without a default. Every srarap
 option of that kind either says its default in its help (``[default: 0.14]``: the solver
 settings, whose value comes from the handle file or the defaults) or is a flag or has none;
-the column gets that default, ``off`` for a flag, and ``-`` otherwise.
+the column gets that default, ``off`` for a flag, and ``-`` otherwise. Its Type column: a
+range as Click writes it (``x>0``), where mkdocs-click said "`0` and above" for open bounds.
 """
 import re
+
+import click
+from mkdocs_click import _docs
+
+_MKDOCS_CLICK_TYPE = _docs._format_table_option_type
 
 ROW = re.compile(r"<tr>\s*<td>(?P<name>.*?)</td>\s*<td>(?P<type>.*?)</td>\s*"
                  r"<td>(?P<help>.*?)</td>\s*<td><code>Sentinel\.UNSET</code></td>\s*</tr>",
@@ -64,6 +70,24 @@ def _api(html):
     html = TYPE_CELL.sub(_type_cell, html)
     html = ROLE.sub(_short, html)
     return DOUBLED.sub(r"\1", html)
+
+
+def _range_type(option):
+    """An option's type as the table says it, with its range as Click states it (``x>0``):
+    mkdocs-click says "`0` and above" for an open bound too (``--alpha`` must be > 0)."""
+    kind = option.type
+    if isinstance(kind, (click.IntRange, click.FloatRange)):
+        return f"{kind.name} (`{kind._describe_range()}`)"
+    return _MKDOCS_CLICK_TYPE(option)
+
+
+def on_config(config):
+    """MkDocs' hook, before any page: the range column fixed where mkdocs-click builds it."""
+    global _MKDOCS_CLICK_TYPE
+    if _docs._format_table_option_type is not _range_type:
+        _MKDOCS_CLICK_TYPE = _docs._format_table_option_type
+        _docs._format_table_option_type = _range_type
+    return config
 
 
 def on_page_content(html, page, config, files):

@@ -1,6 +1,7 @@
 """Every table the code generates, written where the docs show it: the README's settings table
 (from the settings table, ``srarap_cli.cli.options.markdown_table``) and format table (from
-the format registry, ``srarap_cli.io.mesh.meshio_formats.markdown_table``), and the handle
+the format registry, ``srarap_cli.io.mesh.meshio_formats.markdown_table``), the warning codes
+(``docs/reference/warnings.md``, from ``srarap_cli.runtime.warning_codes``), and the handle
 files' JSON Schema (``docs/handles.schema.json``, ``srarap_cli.io.handles.schema``).
 
 Run from the repository root after changing a setting, a format or the handle-file schema:
@@ -17,6 +18,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 README = os.path.join(ROOT, "README.md")
 SCHEMA = os.path.join(HERE, "handles.schema.json")
+WARNINGS = os.path.join(HERE, "reference", "warnings.md")
 
 
 def replace_table(text: str, table: str) -> str:
@@ -33,12 +35,15 @@ def generated() -> dict[str, str]:
     from srarap_cli.cli.options import markdown_table as settings_table
     from srarap_cli.io.handles.schema import schema_text
     from srarap_cli.io.mesh.meshio_formats import markdown_table as formats_table
+    from srarap_cli.runtime.warning_codes import markdown_table as warnings_table
 
     with open(README, encoding="utf-8") as fh:
         readme = fh.read()
     for table in (settings_table(), formats_table()):
         readme = replace_table(readme, table)
-    return {README: readme, SCHEMA: schema_text()}
+    with open(WARNINGS, encoding="utf-8") as fh:
+        codes = replace_table(fh.read(), warnings_table())
+    return {README: readme, SCHEMA: schema_text(), WARNINGS: codes}
 
 
 def main(argv: list[str]) -> int:

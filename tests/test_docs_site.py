@@ -40,6 +40,15 @@ def test_no_page_shows_raw_markup_or_unset_defaults(site):
         assert "``" not in body, page
 
 
+def test_the_cli_reference_states_open_ranges_as_open(site):
+    """--alpha must be > 0: the reference said "0 and above" (issue 60)."""
+    text = (site / "reference" / "cli" / "index.html").read_text(encoding="utf-8")
+    row = re.search(r"<code>--alpha</code>.*?</tr>", text, re.DOTALL)[0]
+    assert "x&gt;0" in row and "and above" not in row
+    row = re.search(r"<code>--max-iter</code>.*?</tr>", text, re.DOTALL)[0]
+    assert "x&gt;=0" in row
+
+
 def test_every_image_is_there_and_every_figure_is_on_its_pages(site):
     for page in pages(site):
         for src in re.findall(r'<img[^>]+src="([^"]+)"', page.read_text(encoding="utf-8")):

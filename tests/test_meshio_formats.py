@@ -36,7 +36,8 @@ def test_a_format_writes_and_reads_back_exactly(name, faces, tmp_path, capsys):
     keeps, split = FORMATS[name].keeps_vertex_data, faces != "triangles" and not TABLE[name].quads
     assert [w for w in lost if "per-vertex" in w] == ([] if keeps else [
         f"per-vertex data (weight) not written: {TABLE[name].display} keeps positions and "
-        "faces; write .vtu to keep it"])
+        "faces; write .vtu to keep it [format-drops]"])
+    assert all(w.code == "format-drops" for w in lost)
     assert ["quads and larger polygons written as triangles" in w for w in lost].count(
         True) == split
     back = read_mesh(path)
@@ -174,6 +175,6 @@ def test_one_pentagon_among_quads_splits_only_itself(name, tmp_path):
                 face_vertices=np.concatenate(faces))
     lost = write_mesh(tmp_path / f"m{FORMATS[name].extension}", mesh)
     assert lost == ["1 polygons of more than 4 corners written as triangles (the format keeps "
-                    "triangles and quads)"]
+                    "triangles and quads) [format-drops]"]
     back = read_mesh(tmp_path / f"m{FORMATS[name].extension}")
     assert (back.face_sizes == 4).sum() == len(quads) - 1 and (back.face_sizes == 3).sum() == 3

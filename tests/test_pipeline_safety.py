@@ -141,3 +141,44 @@ def test_a_log_shows_the_warnings_then_progress_lines_before_the_solve_ends(tmp_
                            capture_output=True, timeout=600,
                            env={**os.environ, "SRARAP_PROGRESS_EVERY": "0.05"})
     assert "progress" not in quiet.stderr and "more than a full turn" in quiet.stderr
+
+
+def test_a_verbose_log_says_each_stage_as_it_ends(tmp_path):
+    """Issue 60: ``-v``'s stage lines came after the solve. Now each as its stage ends: the
+    reading and the checks before any progress line, the coarse solve's line before the
+    full-resolution iterations' progress, the write's last, before the summary."""
+    spot = os.path.join(ROOT, "sample_meshes", "spot.obj")
+    nod = os.path.join(ROOT, "configs", "spot-nod.yaml")
+    with open(tmp_path / "log.txt", "w") as log:
+        done = subprocess.run([sys.executable, "-m", "srarap_cli", "deform", spot, nod,
+                               "-o", "o.obj", "--multires", "1000", "-v"], cwd=tmp_path,
+                              stderr=log, timeout=600,
+                              env={**os.environ, "SRARAP_PROGRESS_EVERY": "0.05"})
+    assert done.returncode == 0
+    lines = (tmp_path / "log.txt").read_text().splitlines()
+    at = {line.split(": ", 2)[2].rsplit(" ", 2)[0]: k for k, line in enumerate(lines)
+          if line.startswith("srarap: stage: ")}
+    order = ["read", "checks", "multires: simplify", "setup", "multires: coarse solve",
+             "multires: full-resolution iterations", "solve", "write"]
+    assert [at[name] for name in order] == sorted(at[name] for name in order), lines
+    progress = [k for k, line in enumerate(lines) if line.startswith("srarap: progress: ")]
+    fine = [k for k in progress if "full resolution, iteration" in lines[k]]
+    assert at["checks"] < progress[0] and fine and at["multires: coarse solve"] < fine[0]
+    assert at["write"] < next(k for k, line in enumerate(lines)
+                              if line.startswith("srarap deform: "))
+
+
+def test_an_animation_log_shows_warnings_first_then_frames_as_they_are_written(tmp_path):
+    bar = os.path.join(ROOT, "sample_meshes", "bar.obj")
+    keys = os.path.join(ROOT, "configs", "bar-twist-animated.yaml")
+    with open(tmp_path / "log.txt", "w") as log:
+        done = subprocess.run([sys.executable, "-m", "srarap_cli", "animate", bar, keys, "-o",
+                               "f_{:03d}.obj", "--frames", "20"], cwd=tmp_path, stderr=log,
+                              timeout=600, env={**os.environ, "SRARAP_PROGRESS_EVERY": "0.01"})
+    assert done.returncode == 0
+    lines = (tmp_path / "log.txt").read_text().splitlines()
+    warned = next(k for k, line in enumerate(lines) if "[unreached-keys]" in line)
+    frames = [k for k, line in enumerate(lines) if line.startswith("srarap: progress: frame ")]
+    assert frames and warned < frames[0] and frames[-1] == len(lines) - 2
+    assert "frame 20/20" in lines[frames[-1]] and lines[-1].startswith("srarap animate: ")
+    assert sum("[unreached-keys]" in line for line in lines) == 1

@@ -100,6 +100,16 @@ def test_the_formats_table_is_the_format_registry():
     assert markdown_table() in Path(ROOT, "README.md").read_text(encoding="utf-8")
 
 
+def test_the_docs_home_page_names_the_formats_there_are():
+    """It said OBJ, PLY, OFF, STL long after the meshio formats came (issue 60)."""
+    from srarap_cli.io.mesh.formats import FORMATS
+    from srarap_cli.io.mesh.meshio_formats import TABLE
+    home = Path(ROOT, "docs", "index.md").read_text(encoding="utf-8")
+    own = [f.name.upper() for f in FORMATS.values() if f.name not in TABLE]
+    assert own == ["OBJ", "OFF", "PLY", "STL"] and all(name in home for name in own)
+    assert f"{len(TABLE)} simulation formats more" in home
+
+
 def test_the_readme_stays_a_front_door():
     assert len(Path(ROOT, "README.md").read_bytes()) <= 25_000
 

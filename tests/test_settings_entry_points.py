@@ -35,7 +35,9 @@ FORMS = {
     "start": ["laplacian", "harmonic"],
     "multires": ["off", "auto", 60, "60", "30%", 0.3, "0.3"],
     "multires_mode": ["transfer", "refine"],
-    "strict": [True, False],  # the problem has no warning: the same bytes either way
+    "strict": ["request", "all", "off", True, False],  # the problem has no warning: the same
+    # bytes either way
+    "allow": [["needles", "units"], "duplicate-faces"],
     "threads": [2, 1],  # any count gives the same bytes
 }
 #: forms that need a companion setting to make a difference (``tol`` 0 runs every iteration
@@ -108,7 +110,13 @@ def _cli(folder, given, plain):
             "--keep-unconverged"]
     for name, value in given.items():
         flag = BY_NAME[name].flag
-        args += ([flag] if value else []) if BY_NAME[name].kind == "flag" else [flag, str(value)]
+        if BY_NAME[name].kind == "level":  # --strict alone is request; false is not giving it
+            args += {True: [flag], False: []}.get(value, [f"{flag}={value}"])
+        elif BY_NAME[name].kind == "codes":
+            args += [a for code in ([value] if isinstance(value, str) else value)
+                     for a in (flag, code)]
+        else:
+            args += [flag, str(value)]
     r = CliRunner().invoke(main, args)
     assert r.exit_code in (0, 3), r.output
     return out.read_bytes()

@@ -105,7 +105,7 @@ def test_every_setting_is_an_option_of_deform_and_a_handle_file_key(tmp_path):
     V = np.zeros((4, 3))
     for s in SETTINGS:
         assert s.flag in help_text
-        value = s.choices[-1] if s.choices else (True if s.kind == "flag" else
+        value = s.choices[-1] if s.choices else ("needles" if s.kind == "codes" else
                                                  "off" if s.kind == "size" else
                                                  s.minimum + 1 if s.minimum is not None else 1)
         if s.kind == "float":

@@ -1,19 +1,19 @@
 """``srarap animate``: keyframed handles -> one deformed mesh per frame."""
-import sys
-import time
 from typing import Any
 
 import click
 
 from ..runtime import exit_codes
+from ..runtime.stages import heard_by
 from ..solver.stop import StopReason
 from ..tasks.animate_job import AnimateJob, run_animation
 from ..tasks.frame_files import MAX_FRAMES
-from .common import FiniteFloat, cache_option, guarded, report, with_verbosity
-from .options import settings_options
+from .common import EarlyWarnings, FiniteFloat, cache_option, guarded, report, with_verbosity
+from .options import StrictCommand, settings_options
+from .progress import FrameProgress
 
 
-@click.command("animate")
+@click.command("animate", cls=StrictCommand)
 @click.argument("mesh")
 @click.argument("handles")
 @click.option("-o", "--output", "pattern", required=True,
@@ -55,12 +55,13 @@ def animate(mesh: str, handles: str, pattern: str, frames: int | None, fps: floa
     job = AnimateJob(mesh, handles, pattern, overrides, frames=frames, fps=fps,
                      max_frames=max_frames, iters_per_frame=iters_per_frame,
                      keep_unconverged=keep_unconverged, log=log, resume=resume, cache=cache)
-    progress = _Progress(enabled=verbosity != 0 and sys.stderr.isatty())
+    progress, early = FrameProgress(enabled=verbosity != 0), EarlyWarnings()
     try:
-        done = run_animation(job, on_frame=progress.update)
+        with heard_by(progress.stage if (verbosity or 0) >= 2 else None):
+            done = run_animation(job, on_frame=progress.frame, on_warnings=early)
     finally:
         progress.close()
-    report(verbosity, warnings=done.warnings,
+    report(verbosity, warnings=early.rest(done.warnings),
            details=done.last.report_lines() if done.last else [],
            summary=_summary(done, pattern, iters_per_frame))
     if done.unconverged and iters_per_frame is None:
@@ -88,23 +89,3 @@ def _summary(done, pattern, budget):
                  f"iterations ({reason}: {result.stop_detail}; raise {limit}, or "
                  "--keep-unconverged writes it and goes on)")
     return head
-
-
-class _Progress:
-    """A one-line progress display on stderr (only on a terminal)."""
-
-    def __init__(self, enabled):
-        self.enabled, self.start = enabled, time.perf_counter()
-
-    def update(self, done, total):
-        if not self.enabled:
-            return
-        elapsed = time.perf_counter() - self.start
-        rate = done / max(elapsed, 1e-9)
-        eta = (total - done) / max(rate, 1e-9)
-        sys.stderr.write(f"\rframe {done}/{total}  {rate:.2f} frames/s  ETA {eta:.0f} s ")
-        sys.stderr.flush()
-
-    def close(self):
-        if self.enabled:
-            sys.stderr.write("\n")

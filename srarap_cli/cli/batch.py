@@ -12,6 +12,7 @@ from ..runtime.commit import commit_files
 from ..runtime.encoding import utf8
 from ..runtime.errors import OutputError
 from ..runtime.signals import Terminated, block
+from ..solver.settings import BY_NAME
 from ..tasks.batch.manifest import check_outputs, load_manifest
 from ..tasks.batch.report import junit_xml, report_html
 from ..tasks.batch.rows import BatchInterrupted
@@ -19,12 +20,13 @@ from ..tasks.batch.run import run_batch
 from ..tasks.job_status import SUMMARY_FIELDS, WARNING_JOIN, JobStatus
 from ..tasks.preflight import check_output_path
 from .common import guarded, say
+from .options import StrictCommand, setting_option
 
 #: a Dask scheduler address: protocol://host:port, or host:port
 SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
 
 
-@click.command("batch")
+@click.command("batch", cls=StrictCommand)
 @click.argument("manifest")
 @click.option("--workers", type=click.IntRange(min=1), default=1, show_default=True,
               help="Worker processes.")
@@ -44,20 +46,19 @@ SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
 @click.option("--threads", type=click.IntRange(min=1), metavar="N",
               help="Threads for each job's solve, at most the CPUs divided by --workers. "
               "[default: $SRARAP_THREADS, else the CPUs divided by --workers]")
-@click.option("--strict", is_flag=True,
-              help="Every job's warnings are errors (as strict: true in the manifest's "
-              "defaults): the job fails with exit code 4 in its row.")
+@setting_option(BY_NAME["strict"])
+@setting_option(BY_NAME["allow"])
 @click.option("-q", "--quiet", is_flag=True, help="No summary table.")
 @guarded
 def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unconverged: bool,
-          report: str | None, junit: str | None, threads: int | None, strict: bool,
-          quiet: bool) -> None:
+          report: str | None, junit: str | None, threads: int | None, strict: str | None,
+          allow: tuple[str, ...] | None, quiet: bool) -> None:
     """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
 
     Exit code 0 when every job is ok or up to date, 8 when any job failed or regressed
     against its golden mesh, else 3 when any did not converge (its mesh is not written unless
     --keep-unconverged; the status is recorded, so an unchanged job reports it again on every
-    rerun without solving).
+    rerun without solving). --strict and --allow are each job's, over the manifest's.
     """
     if scheduler is not None and scheduler != "local" and not SCHEDULER.fullmatch(scheduler):
         raise click.BadParameter(f"{scheduler!r} is neither 'local' nor a scheduler address "
@@ -67,9 +68,10 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     if junit is not None:
         check_output_path(junit, (".xml",), "--junit")
     jobs = load_manifest(manifest)
-    if strict:  # over the manifest's defaults and each job's settings, as deform's flag
-        for job in jobs:
-            job["settings"] = {**job["settings"], "strict": True}
+    for job in jobs:  # over the manifest's defaults and each job's settings, as in deform
+        mine = job["settings"]
+        job["settings"] = {**mine, **({"strict": strict} if strict else {}),
+                           **({"allow": [*mine.get("allow", ()), *allow]} if allow else {})}
     check_outputs(jobs, out, manifest)
     try:
         os.makedirs(out, exist_ok=True)

@@ -35,7 +35,7 @@ BENCH_FILES = ("curves.csv", "summary.json", "energy.png")
 @click.option("-o", "--output", "out",
               help="Folder for curves.csv, summary.json and energy.png (created if missing).")
 @settings_options(exclude=("method", "multires", "multires_mode", "time_limit", "accel", "start",
-                           "strict"),
+                           "strict", "allow"),
                defaults=OWN_DEFAULTS)
 @guarded
 def bench(mesh: str, handles: str, methods: str, time_budget: float, out: str | None,

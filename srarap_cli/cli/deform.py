@@ -6,6 +6,7 @@ import click
 
 from ..io.mesh.formats import MeshFormat
 from ..runtime import exit_codes, memory
+from ..runtime.stages import heard_by
 from ..solver.multires.size import AUTO_THRESHOLD
 from ..solver.stop import StopReason
 from ..tasks.job import DeformJob, JobStatus, run_job
@@ -21,11 +22,11 @@ from .common import (
     with_verbosity,
     write_stdout,
 )
-from .options import settings_options
+from .options import StrictCommand, settings_options
 from .progress import SolveProgress
 
 
-@click.command("deform")
+@click.command("deform", cls=StrictCommand)
 @click.argument("mesh")
 @click.argument("handles")
 @click.option("-o", "--output", "out", required=True,
@@ -72,7 +73,8 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
     progress = SolveProgress(enabled=verbosity != 0)
     early = EarlyWarnings()
     try:
-        done = run_job(job, callback=progress, write_stdout=write_stdout, on_warnings=early)
+        with heard_by(progress.stage if (verbosity or 0) >= 2 else None):
+            done = run_job(job, callback=progress, write_stdout=write_stdout, on_warnings=early)
     finally:
         progress.close()
     measured = memory.gigabytes(done.peaks)

@@ -9,6 +9,7 @@ from typing import Any, TypeVar
 
 import click
 
+from ..runtime.warning_codes import CODES, REQUEST
 from ..solver.multires.size import parse_size
 from ..solver.settings import SETTINGS, Setting
 from .common import FiniteFloat
@@ -23,9 +24,13 @@ def setting_option(setting: Setting, default: object = None) -> Callable[[F], F]
     shown = setting.default if default is None else default
     shown = setting.default_text if shown is None and setting.default_text else shown
     text = f"{setting.help} [default: {'none' if shown is None else shown}]"
-    if setting.kind == "flag":
-        return click.option(setting.flag, setting.name, is_flag=True, default=None,
-                            help=f"{setting.help} [default: off]")
+    if setting.kind == "level":  # a bare --strict is made --strict=request by StrictCommand
+        return click.option(setting.flag, setting.name, type=click.Choice(setting.choices),
+                            metavar="[=all]", help=f"{setting.help} [default: off]")
+    if setting.kind == "codes":
+        return click.option(setting.flag, setting.name, multiple=True, metavar=setting.metavar,
+                            type=click.Choice(tuple(CODES)), show_choices=False,
+                            callback=lambda _c, _p, v: v or None, help=setting.help)
     kind: click.ParamType
     if setting.kind == "choice":
         kind = click.Choice(setting.choices)
@@ -39,6 +44,23 @@ def setting_option(setting: Setting, default: object = None) -> Callable[[F], F]
         kind = FiniteFloat(min=setting.minimum, min_open=setting.strict)
     return click.option(setting.flag, setting.name, type=kind, metavar=setting.metavar,
                         help=text)
+
+
+class StrictCommand(click.Command):
+    """A command with a ``--strict[=all]`` option: a bare ``--strict`` means
+    ``--strict=request`` (an option whose value may be left out would take the next
+    argument, the mesh's path, as its value)."""
+
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        return super().parse_args(ctx, bare_strict(args))
+
+
+def bare_strict(args: Sequence[str]) -> list[str]:
+    """``args`` with each bare ``--strict`` before ``--`` spelled ``--strict=request``."""
+    out = list(args)
+    end = out.index("--") if "--" in out else len(out)
+    return [f"--strict={REQUEST}" if a == "--strict" and i < end else a
+            for i, a in enumerate(out)]
 
 
 def _size_option(_ctx, _param, value):
@@ -75,7 +97,8 @@ def markdown_table() -> str:
     """The solver settings as the README's Markdown table (a test keeps the two equal)."""
     rows = ["| option | default | meaning |", "|---|---|---|"]
     for s in SETTINGS:
-        default = (s.default_text or "none" if s.default is None else "off" if s.kind == "flag"
+        default = (s.default_text or "none" if s.default is None else "none" if s.default == ()
                    else f"`{s.default}`")
-        rows.append(f"| `{s.flag}` | {default} | {s.help} |")
+        flag = {"level": f"{s.flag}[=all]", "codes": f"{s.flag} CODE"}.get(s.kind, s.flag)
+        rows.append(f"| `{flag}` | {default} | {s.help} |")
     return "\n".join(rows) + "\n"

@@ -58,7 +58,35 @@ class SolveProgress:
         sys.stderr.write(f"\r\033[K{text}" if self.terminal else f"srarap: progress: {text}\n")
         sys.stderr.flush()
 
+    def say(self, line: str) -> None:
+        """Print ``line`` on stderr, on a terminal over the progress line (redrawn at the next
+        row), so that the two never share a line."""
+        sys.stderr.write(("\r\033[K" if self.shown and self.terminal else "") + line + "\n")
+        sys.stderr.flush()
+
+    def stage(self, name: str, seconds: float) -> None:
+        """A stage's ``-v`` line, as it ends (see :mod:`srarap_cli.runtime.stages`)."""
+        self.say(f"srarap: stage: {name} {seconds:.2f} s")
+
     def close(self) -> None:
         if self.shown and self.terminal:
             sys.stderr.write("\r\033[K")
             sys.stderr.flush()
+
+
+class FrameProgress(SolveProgress):
+    """Progress of an animation, frame by frame: frames done, rate and time left, redrawn on
+    a terminal, a line every :func:`log_interval` seconds in a log; ``-q`` silences it."""
+
+    def frame(self, done: int, total: int) -> None:
+        if not self.enabled:
+            return
+        now = time.perf_counter() - self.start
+        if done < total and (now < self.delay or now - self.last < self.every):
+            return
+        self.last, self.shown = now, True
+        rate = done / max(now, 1e-9)
+        text = (f"frame {done}/{total}  {rate:.2f} frames/s  "
+                f"ETA {(total - done) / max(rate, 1e-9):.0f} s  {now:.1f} s")
+        sys.stderr.write(f"\r\033[K{text}" if self.terminal else f"srarap: progress: {text}\n")
+        sys.stderr.flush()

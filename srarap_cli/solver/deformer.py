@@ -15,6 +15,7 @@ from scipy.sparse import csgraph
 
 from ..runtime.parallel import using_threads
 from ..runtime.threads import single_threaded
+from ..runtime.warning_codes import note
 from . import api_checks
 from .drivers import DRIVERS, Monitor
 from .energy import bending_energy, membrane_energy
@@ -318,13 +319,14 @@ def unanchored(graph: Any, constrained: np.ndarray) -> tuple[np.ndarray, list[st
     placed = int(np.sum((graph.degree == 0) & constrained))
     notes = []
     if lonely.size or placed:
-        notes.append(f"{lonely.size + placed} unreferenced vertices (in no triangle): "
-                     f"{lonely.size} kept at rest, {placed} constrained ones placed at their "
-                     "targets")
+        notes.append(note("unreferenced-vertices",
+                          f"{lonely.size + placed} unreferenced vertices (in no triangle): "
+                          f"{lonely.size} kept at rest, {placed} constrained ones placed at "
+                          "their targets"))
     if floating.size:
         parts = np.unique(label[floating]).size
-        notes.append(f"{parts} connected part(s) without a constrained vertex "
-                     f"({floating.size} vertices) kept at rest")
+        notes.append(note("part-at-rest", f"{parts} connected part(s) without a constrained "
+                          f"vertex ({floating.size} vertices) kept at rest"))
     return np.union1d(lonely, floating), notes
 
 
@@ -332,11 +334,11 @@ def weight_warnings(graph: Any) -> list[str]:
     """Warnings about edge weights that can keep a solve from settling."""
     out = []
     if graph.degenerate:
-        out.append(f"{graph.degenerate} triangle angles of zero-area faces have no finite "
-                   "cotangent; their weights count as 0")
+        out.append(note("degenerate-angles", f"{graph.degenerate} triangle angles of zero-area "
+                        "faces have no finite cotangent; their weights count as 0"))
     negative = int(np.count_nonzero(graph.c < 0)) // 2
     if negative:
-        out.append(f"{negative} edges have negative cotangent weights: the membrane energy is "
-                   "not bounded below and the solve may not settle; use --weights "
-                   "cotan-clamped (default) or uniform")
+        out.append(note("negative-weights", f"{negative} edges have negative cotangent weights: "
+                        "the membrane energy is not bounded below and the solve may not "
+                        "settle; use --weights cotan-clamped (default) or uniform"))
     return out

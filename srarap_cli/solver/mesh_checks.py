@@ -5,6 +5,7 @@ import scipy.sparse as sp
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
+from ..runtime.warning_codes import note
 from .libigl import igl
 from .operators import triangle_normals
 
@@ -106,28 +107,31 @@ def mesh_warnings(V: np.ndarray, F: np.ndarray) -> list[str]:
     --------
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]])
     >>> mesh_warnings(V, np.array([[0, 1, 2], [2, 0, 1]]))
-    ['1 duplicate faces (same vertices as another face)']
+    ['1 duplicate faces (same vertices as another face) [duplicate-faces]']
     """
     out = []
     collapsed = len(F) - len(solvable_faces(F))
     if collapsed:
-        out.append(f"{collapsed} faces repeat a vertex; left out of the solve")
+        out.append(note("collapsed-faces", f"{collapsed} faces repeat a vertex; left out of the solve"))
     F = solvable_faces(F)
     distinct = unique_rows(np.sort(F, axis=1))[0]
     duplicates = len(F) - len(distinct)
     if duplicates:
-        out.append(f"{duplicates} duplicate faces (same vertices as another face)")
+        out.append(note("duplicate-faces",
+                        f"{duplicates} duplicate faces (same vertices as another face)"))
     scale = float(np.ptp(V, axis=0).max()) ** 2 if len(V) else 0.0
     area2 = igl.doublearea(V, F)
     zero = ~(area2 > 1e-14 * scale)
     if zero.any():
-        out.append(f"{int(zero.sum())} zero-area faces; their edges get no weight from them")
+        out.append(note("zero-area", f"{int(zero.sum())} zero-area faces; their edges get no "
+                        "weight from them"))
     with np.errstate(invalid="ignore"):
         angles = np.degrees(igl.internal_angles(V, F[~zero])) if (~zero).any() else np.zeros((0, 3))
     needles = int((angles.min(axis=1, initial=180) < NEEDLE_DEGREES).sum()) if len(angles) else 0
     if needles:
-        out.append(f"{needles} needle faces (an angle under {NEEDLE_DEGREES:g} degree); "
-                   "cotangents are capped at 1000 so no edge weight can swamp the others")
+        out.append(note("needles", f"{needles} needle faces (an angle under {NEEDLE_DEGREES:g} "
+                        "degree); cotangents are capped at 1000 so no edge weight can swamp "
+                        "the others"))
     edges, counts = edge_counts(distinct)  # duplicates said above
     out.extend(_manifold_warnings(distinct, len(V), counts))
     out.extend(_unwelded_warnings(V, edges, counts))
@@ -146,19 +150,22 @@ def _unwelded_warnings(V, edges, counts):
     extra = int(border.size - first.size)
     if not extra:
         return []
-    return [f"{extra} vertices sit exactly on another vertex ({int((count > 1).sum())} "
-            "positions): the faces there share no vertex, so the surface is cut open; weld "
-            "coincident vertices first (trimesh: merge_vertices(merge_tex=True, merge_norm=True))"]
+    return [note("coincident-vertices",
+                 f"{extra} vertices sit exactly on another vertex ({int((count > 1).sum())} "
+                 "positions): the faces there share no vertex, so the surface is cut open; "
+                 "weld coincident vertices first (trimesh: merge_vertices(merge_tex=True, "
+                 "merge_norm=True))")]
 
 
 def _manifold_warnings(F, n, counts):
     out = []
     if (counts > 2).any():
-        out.append(f"{int((counts > 2).sum())} non-manifold edges (more than two faces); solved, "
-                   "the operators are defined there")
+        out.append(note("non-manifold", f"{int((counts > 2).sum())} non-manifold edges (more "
+                        "than two faces); solved, the operators are defined there"))
     bad = int((fans_per_vertex(F, n) > 1).sum())
     if bad:
-        out.append(f"{bad} non-manifold vertices (faces around them form several fans); solved")
+        out.append(note("non-manifold", f"{bad} non-manifold vertices (faces around them form "
+                        "several fans); solved"))
     return out
 
 

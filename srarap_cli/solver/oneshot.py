@@ -5,6 +5,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..runtime.warning_codes import note
 from .deformer import Deformer
 from .interface import Solver
 from .multires.deformer import MultiresDeformer
@@ -40,8 +41,8 @@ def make_deformer(V: ArrayLike, F: ArrayLike, constrained: ArrayLike,
     if size is None:
         deformer = Deformer(V, F, constrained, settings=settings, area=area, labels=labels)
         if settings.multires not in ("auto", "off"):
-            deformer.warnings.append(f"multires {settings.multires} is not below the mesh's "
-                                     f"{n} vertices: solved directly")
+            deformer.warnings.append(note("multires-size", f"multires {settings.multires} is not "
+                                          f"below the mesh's {n} vertices: solved directly"))
         return deformer
     return MultiresDeformer.or_direct(V, F, constrained, labels, settings=settings, size=size,
                                       cache=cache, area=area)

@@ -18,6 +18,7 @@ from typing import Any
 
 from ..runtime.errors import unknown_key
 from ..runtime.numbers import spelled, whole
+from ..runtime.warning_codes import parse_codes, parse_level
 from .local_step import METHODS
 from .multires.size import AUTO_RATIO, AUTO_SIZE, AUTO_THRESHOLD, parse_size
 
@@ -34,7 +35,8 @@ class Setting:
     Attributes
     ----------
     name : str, the Python keyword and handle-file key (the CLI flag uses dashes)
-    kind : {"float", "int", "choice", "size", "flag"}
+    kind : {"float", "int", "choice", "size", "level", "codes"}; ``level`` is ``strict``'s
+        (true, false, off, request, all), ``codes`` a list of warning codes
     default : the value when nobody gives one (None: no limit)
     help : str, one sentence for ``--help`` and the README
     stage : {"setup", "solve", "build", "run"}
@@ -68,10 +70,11 @@ class Setting:
             if value not in self.choices:
                 raise error(f"{self.name} must be one of {', '.join(self.choices)}")
             return value
-        if self.kind == "flag":
-            if not isinstance(value, bool):
-                raise error(f"{self.name} must be true or false")
-            return value
+        if self.kind in ("level", "codes"):
+            try:
+                return parse_level(value) if self.kind == "level" else parse_codes(value)
+            except ValueError as exc:
+                raise error(f"{self.name} {exc}") from None
         if self.kind == "size":
             try:
                 return parse_size(value)
@@ -144,9 +147,14 @@ SETTINGS = (
             "With multires: refine = the transferred result starts full-resolution iterations "
             "run to tol; transfer = stop after the transfer (the paper's approximation).",
             "build", choices=("refine", "transfer")),
-    Setting("strict", "flag", False,
-            "Treat every warning (an implausible motion, a mesh problem, data the output "
-            "format drops) as an error: exit 4 with the warning as the message.", "run"),
+    Setting("strict", "level", "off",
+            "Treat the warnings about the request (an implausible motion, a part moved "
+            "rigidly or left at rest, data the output format drops) as errors: exit 4 "
+            "listing them; all: the notes on the mesh too (needles, duplicate faces...).",
+            "run", choices=("off", "request", "all")),
+    Setting("allow", "codes", (),
+            "A warning code that strict accepts (repeatable; see the warning codes).",
+            "run", metavar="CODE"),
 )
 BY_NAME = {s.name: s for s in SETTINGS}
 DEFAULTS: dict[str, Any] = {s.name: s.default for s in SETTINGS}
@@ -187,7 +195,8 @@ class Settings:
     threads: int | None
     multires: int | float | str
     multires_mode: str
-    strict: bool
+    strict: str
+    allow: tuple[str, ...]
 
     def __post_init__(self) -> None:
         for name in NAMES:
@@ -220,9 +229,10 @@ STAGES = ("setup", "solve", "build", "run")
 
 def resolve(*layers: "Mapping[str, Any] | Settings") -> Settings:
     """The one way settings are made: the defaults, then each layer in turn (later layers
-    win; a None value means "not given"). A layer is a mapping of setting names (a handle
-    file's ``solver`` section, a manifest's ``settings``, the command line's options, the
-    Python API's keywords, each checked by its reader) or a :class:`Settings`.
+    win; a None value means "not given"; the warning codes ``allow`` accepts add up). A
+    layer is a mapping of setting names (a handle file's ``solver`` section, a manifest's
+    ``settings``, the command line's options, the Python API's keywords, each checked by its
+    reader) or a :class:`Settings`.
 
     Raises ValueError naming the setting for a bad value, KeyError for an unknown name.
     """
@@ -232,7 +242,9 @@ def resolve(*layers: "Mapping[str, Any] | Settings") -> Settings:
         for name, value in items.items():
             if name not in BY_NAME:
                 raise KeyError(f"unknown setting {name!r}")
-            if value is not None:
+            if value is not None and BY_NAME[name].kind == "codes":  # accepted by any layer
+                merged[name] = (*parse_codes(merged[name]), *parse_codes(value))
+            elif value is not None:
                 merged[name] = value
     return Settings(**merged)
 

@@ -17,11 +17,11 @@ from ..runtime.commit import commit_files
 from ..runtime.encoding import utf8
 from ..runtime.errors import InputError
 from ..runtime.limits import check_solve
+from ..runtime.warning_codes import note
 from ..solver.result import DeformResult
 from ..solver.settings import resolve
 from .animation import FRAME_FIELDS, Animator, FrameState, fingerprint, unreached_keys
 from .frame_files import MAX_FRAMES, check_pattern, frame_count, frames_on_disk, remove_stale, suffix
-from .pipeline import refuse_warnings
 from .preflight import check_output_path, read_any_mesh, refuse_overwrite
 
 #: the resume state, in the frames' folder
@@ -87,10 +87,11 @@ class AnimationOutcome:
         return sum(not r["converged"] for r in self.rows)
 
 
-def run_animation(job: AnimateJob,
-                  on_frame: Callable[[int, int], None] | None = None) -> AnimationOutcome:
+def run_animation(job: AnimateJob, on_frame: Callable[[int, int], None] | None = None,
+                  on_warnings: Callable[[list[str]], None] | None = None) -> AnimationOutcome:
     """Run ``job``; raise on failure (InputError, OutputError, UsageProblem, ...).
-    ``on_frame(done, total)`` is called after each frame is committed (a progress display)."""
+    ``on_frame(done, total)`` is called after each frame is committed (a progress display);
+    ``on_warnings`` hears the warnings as they are known, before the setup and the frames."""
     folder = check_pattern(job.pattern)
     if job.log is not None:
         check_output_path(job.log, LOG_FORMATS, "log")
@@ -108,11 +109,11 @@ def run_animation(job: AnimateJob,
     run_id = fingerprint(source, (job.handles, *referenced_files(job.handles)), opts,
                          n_frames, job.fps, job.iters_per_frame, job.pattern)
     state = _resume_state(state_path, run_id) if job.resume else None
-    animator = Animator(source, constraints, opts, cache=job.cache, name=job.mesh)
     # what every frame's file loses, and keys no frame shows: said once, errors under strict
     lost = format_mesh(source, suffix(job.pattern))[1] + unreached_keys(
         constraints, n_frames, job.fps, job.handles)
-    refuse_warnings(opts, lost)
+    animator = Animator(source, constraints, opts, cache=job.cache, name=job.mesh,
+                        known=lost, on_warnings=on_warnings)
     frame_bytes = frame_formatter(source, suffix(job.pattern))
 
     def write_frame(f, positions, st):
@@ -127,7 +128,7 @@ def run_animation(job: AnimateJob,
                          state=state, on_frame=write_frame, fingerprint=run_id)
     rows = (final.rows if final is not None else []) + (
         [animator.stopped_row] if animator.stopped_at is not None else [])
-    notes = animator.warnings + lost + _finish(job, rows, animator.stopped_at, state_path,
+    notes = animator.warnings + _finish(job, rows, animator.stopped_at, state_path,
                                                n_frames)
     return AnimationOutcome(rows, n_frames, 0 if state is None else state.frame + 1,
                             animator.stopped_at, notes, animator.last_result)
@@ -145,8 +146,9 @@ def _finish(job, rows, stopped, state_path, n_frames):
         os.unlink(state_path)
     first = n_frames if stopped is None else stopped
     removed = remove_stale(job.pattern, first)
-    return [f"removed {removed} later frame(s) of an earlier run under {job.pattern!r} "
-            f"(frame {first} on), so that the frames on disk are this run's"] if removed else []
+    return [note("stale-frames", f"removed {removed} later frame(s) of an earlier run under "
+                 f"{job.pattern!r} (frame {first} on), so that the frames on disk are this "
+                 "run's")] if removed else []
 
 
 def _resume_state(path, key):

@@ -24,6 +24,7 @@ from ..io.documents import document_bytes
 from ..io.handles import Constraints
 from ..io.mesh.mesh import Mesh
 from ..runtime.errors import InputError, excerpt
+from ..runtime.warning_codes import note
 from ..solver.quaternion import align_hemisphere, multiply, normalize
 from ..solver.result import DeformResult
 from ..solver.settings import Settings
@@ -76,16 +77,21 @@ class Animator:
     opts : Settings, resolved solver settings (see :func:`srarap_cli.solver.settings.resolve`)
     cache : str, optional, folder for multiresolution coarse meshes
     name : str, the mesh's file, for error messages
+    known : list of str, warnings known already (the frames' format's, keys no frame shows),
+        checked and said with the mesh's and the handles'
+    on_warnings : callable(list of str), optional, hears the warnings as they are known
     """
 
     def __init__(self, mesh: Mesh, constraints: Constraints, opts: Settings, cache: str | None = None,
-                 name: str = "mesh") -> None:
+                 name: str = "mesh", known: Sequence[str] = (),
+                 on_warnings: Callable[[list[str]], None] | None = None) -> None:
         self.mesh = mesh
         self.constraints = constraints
         self.problem = problem(mesh, constraints, name)
         #: warnings: what the mesh checks and the solver found (e.g. mesh problems)
         self.deformer, self.warnings = command_solver(mesh, self.problem, opts, cache,
-                                                      constraints.warnings, constraints)
+                                                      [*known, *constraints.warnings],
+                                                      constraints, on_warnings)
         self.last_result: DeformResult | None = None
 
     def run(self, frames: int, *, max_iter: int | None = None, stop_unconverged: bool = False,
@@ -183,8 +189,8 @@ def unreached_keys(constraints: Constraints, n_frames: int, fps: float | None,
         if late.size:
             name = names[tuple(constraints.ids[slots])]
             rate = f" at --fps {fps:g}" if fps else ""
-            out.append(f"{path}: group {name!r}: {late.size} keyframe(s) at frame(s) "
-                       f"{', '.join(f'{f:.4g}' for f in late[:4])}{rate} come after the last "
-                       f"frame, {n_frames - 1}: no frame shows them (raise --frames, or check "
-                       "the keys' times and --fps)")
+            out.append(note("unreached-keys", f"{path}: group {name!r}: {late.size} keyframe(s) "
+                            f"at frame(s) {', '.join(f'{f:.4g}' for f in late[:4])}{rate} come "
+                            f"after the last frame, {n_frames - 1}: no frame shows them (raise "
+                            "--frames, or check the keys' times and --fps)"))
     return out

@@ -21,6 +21,7 @@ from ..runtime.encoding import utf8
 from ..runtime.errors import NumericalError, OutputError, UsageProblem
 from ..runtime.failures import classify
 from ..runtime.limits import check_solve
+from ..runtime.stages import ended as stage_ended
 from ..solver.settings import resolve
 from ..solver.stop import StopReason
 from .distortion import vertex_distortion
@@ -184,9 +185,10 @@ def recorded_result(job: DeformJob, key: str | None = None) -> JobResult | None:
 
 def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
     peaks: dict[str, int | None] = {}
-    peak = memory.start()
+    peak, mark = memory.start(), time.perf_counter()
     source, source_format = read_any_mesh(job.mesh, job.input_format)
     peaks["read"] = memory.stop(peak)
+    stage_ended("read", time.perf_counter() - mark)
     if fmt is None:
         fmt = source_format
         _check_format_options(fmt, job)
@@ -197,7 +199,7 @@ def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
     peak = memory.start()
     deformed, solve, notes = deform_mesh(source, constraints, opts, callback=callback,
                                          cache=job.cache, name=name, on_warnings=on_warnings)
-    peaks["solve"], peak = memory.stop(peak), memory.start()
+    peaks["solve"], peak, mark = memory.stop(peak), memory.start(), time.perf_counter()
     if job.write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
@@ -214,6 +216,7 @@ def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
         write_stdout(mesh_bytes)  # first: the files are committed only once it was written
     commit_files(files, inside=job.inside)
     peaks["write"] = memory.stop(peak)
+    stage_ended("write", time.perf_counter() - mark)
     return JobResult(job.name, status, status.exit_code, warnings=notes + lost,
                      stop=solve.stop_reason.value, iterations=solve.iterations,
                      energy=solve.energy, solved=True,

@@ -1,4 +1,5 @@
 """From a mesh and its constraints to the deformed mesh: the path every command shares."""
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
@@ -9,6 +10,8 @@ from ..io.handles import Constraints
 from ..io.mesh import Mesh
 from ..runtime.allocator import keep_freed_memory
 from ..runtime.errors import InputError
+from ..runtime.stages import ended as stage_ended
+from ..runtime.warning_codes import failing
 from ..solver.deformer import unanchored, weight_warnings
 from ..solver.interface import Solver
 from ..solver.mesh_checks import geometry_problem, mesh_warnings, solvable_faces
@@ -100,14 +103,19 @@ def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = N
     built, the process keeps freed memory for reuse. ``on_warnings`` hears the warnings as
     they are known, before the setup and before the solve (a log shows them before a long
     run, not after it)."""
+    mark = time.perf_counter()
     notes = list(handle_warnings) + mesh_warnings(mesh.vertices, mesh.triangles()[0])
     if constraints is not None:
         notes += request_warnings(mesh, p, constraints)
-    refuse_warnings(opts, notes)
+    stage_ended("checks", time.perf_counter() - mark)
+    if failing(notes, opts.strict, opts.allow):  # with what the setup would say: all at once
+        refuse_warnings(opts, notes + model_warnings(p, opts))
     if on_warnings is not None:
         on_warnings(list(notes))
+    mark = time.perf_counter()
     deformer = make_deformer(p.V, p.F, p.ids, p.labels, settings=opts, area=p.area,
                              cache=cache)
+    stage_ended("setup", time.perf_counter() - mark)
     keep_freed_memory()  # after the setup, whose large arrays are allocated once
     notes += list(deformer.warnings)
     refuse_warnings(opts, notes)
@@ -134,12 +142,15 @@ def model_warnings(p: Problem, opts: Settings) -> list[str]:
 
 
 def refuse_warnings(opts: Settings, warnings: Sequence[str]) -> None:
-    """Under ``strict``, ``warnings`` as an :class:`InputError` (exit 4): every one of them
-    in its line, so that one run shows all there is to mend (it named only the first)."""
-    if opts.strict and warnings:
-        said = list(dict.fromkeys(warnings))
+    """Under ``strict``, the warnings it fails on (:func:`~srarap_cli.runtime.warning_codes.failing`:
+    the request's, or all, less ``allow``'s codes) as an :class:`InputError` (exit 4), every
+    one of them in its line, so that one run shows all there is to mend."""
+    said = failing(warnings, opts.strict, opts.allow)
+    if said:
         more = f" (and {len(said) - 1} more: {'; '.join(said[1:])})" if len(said) > 1 else ""
-        raise InputError(f"{said[0]}{more} (strict: warnings are errors)")
+        what = "warnings" if opts.strict == "all" else "warnings about the request"
+        raise InputError(f"{said[0]}{more} (strict: {what} are errors; --allow CODE "
+                         "accepts one)")
 
 
 def scatter(mesh: Mesh, p: Problem, positions: np.ndarray, constraints: Constraints,
@@ -184,7 +195,9 @@ def deform_mesh(mesh: Mesh, constraints: Constraints, settings: Settings | None 
     p = problem(mesh, constraints, name)
     deformer, notes = command_solver(mesh, p, settings, cache, constraints.warnings,
                                      constraints, on_warnings)
+    mark = time.perf_counter()
     sub_result = deformer.solve(p.targets, callback=callback)
+    stage_ended("solve", time.perf_counter() - mark)
     positions = scatter(mesh, p, sub_result.positions, constraints)
     rotors = np.tile(IDENTITY, (len(positions), 1))
     rotors[p.vertices] = sub_result.rotors

@@ -8,6 +8,7 @@ from scipy.sparse import csgraph
 
 from ..io.handles import Constraints
 from ..io.handles.transforms import ROUNDING
+from ..runtime.warning_codes import note
 
 
 def rigid_part_warnings(V: np.ndarray, F: np.ndarray, constraints: Constraints) -> list[str]:
@@ -44,10 +45,10 @@ def rigid_part_warnings(V: np.ndarray, F: np.ndarray, constraints: Constraints) 
     held = np.isin(label, np.flatnonzero(rigid))
     names = [name for name, ids in constraints.groups.items() if held[np.asarray(ids)].any()]
     by = f" by group(s) {', '.join(map(repr, names))}" if names else ""
-    return [f"{rigid.sum()} connected part(s) ({sizes.sum()} vertices, the largest "
-            f"{sizes.max()}) are held only by handles that move each rigidly{by}: each "
-            "moves as one piece, apart from the rest of the mesh, at no energy (hold it "
-            "with a fixed group too if it should bend)"]
+    return [note("rigid-part", f"{rigid.sum()} connected part(s) ({sizes.sum()} vertices, the "
+                 f"largest {sizes.max()}) are held only by handles that move each rigidly{by}: "
+                 "each moves as one piece, apart from the rest of the mesh, at no energy (hold "
+                 "it with a fixed group too if it should bend)")]
 
 
 def _rigidly_moved(X, Y, part, n_parts, diagonal):

@@ -6,6 +6,7 @@ import numpy as np
 
 from ...runtime.errors import InputError, unknown_key
 from ...runtime.numbers import spelled, whole
+from ...runtime.warning_codes import note
 
 #: Largest integer a handle file may hold (vertex ids and counts fit in int64 with room).
 MAX_INT = 2 ** 53
@@ -45,9 +46,10 @@ class Context:
     def error(self, message: str) -> InputError:
         return InputError(self._prefixed(message))
 
-    def warn(self, message: str) -> None:
-        """Record a warning naming the file and where in it (``--strict`` makes it an error)."""
-        self.warnings.append(self._prefixed(message))
+    def warn(self, code: str, message: str) -> None:
+        """Record a warning (its ``code``, one of :data:`~srarap_cli.runtime.warning_codes.CODES`)
+        naming the file and where in it (``--strict`` makes it an error)."""
+        self.warnings.append(note(code, self._prefixed(message)))
 
     def mapping(self, value: Any, name: str, allowed: Iterable[str]) -> dict:
         if not isinstance(value, dict):

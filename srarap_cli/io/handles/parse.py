@@ -7,6 +7,7 @@ import numpy as np
 
 from ...runtime.errors import InputError
 from ...runtime.limits import MAX_COORDINATE
+from ...runtime.warning_codes import note
 from ...solver.api_checks import targets as checked_targets
 from ...solver.api_checks import vertex_ids
 from ...solver.settings import parse_mapping
@@ -242,9 +243,9 @@ def _from_sel(path, V):
             raise InputError(f"{def_path}: no such file (the .def that goes with {path})")
         M = read_def(def_path)
         if why := not_rigid(M[:3, :3]):
-            warnings.append(f"{def_path}: the matrix {why}: no rigid motion reaches its "
-                            "targets, so the surface around the handle is stretched or "
-                            "turned inside out")
+            warnings.append(note("not-rigid", f"{def_path}: the matrix {why}: no rigid motion "
+                                 "reaches its targets, so the surface around the handle is "
+                                 "stretched or turned inside out"))
         t[handle] = V[handle] @ M[:3, :3].T + M[:3, 3]
         if not np.isfinite(t[handle]).all() or np.abs(t[handle]).max() > MAX_COORDINATE:
             raise InputError(f"{def_path}: sends handle vertices to infinite or NaN positions "

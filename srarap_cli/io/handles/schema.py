@@ -9,6 +9,7 @@ range, a .def's last row).
 import json
 from typing import Any
 
+from ...runtime.warning_codes import CODES
 from ...solver.settings import SETTINGS
 from .keyframes import EASINGS
 from .keys import KEY_KEYS, STATIC_ACTIONS
@@ -75,7 +76,9 @@ def _keyframe():
 def _setting(s):
     kinds: dict[str, dict[str, Any]] = {
         "float": {"type": "number"}, "int": {"type": "integer"},
-        "flag": {"type": "boolean"},
+        "level": {"enum": [True, False, *s.choices]},
+        "codes": {"oneOf": [{"enum": list(CODES)},
+                            {"type": "array", "items": {"enum": list(CODES)}}]},
         "choice": {"enum": list(s.choices)},
         "size": {"oneOf": [{"type": "integer", "minimum": 4},
                            {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
@@ -86,7 +89,8 @@ def _setting(s):
         kind["exclusiveMinimum" if s.strict else "minimum"] = s.minimum
     if s.default is None:
         kind = {"oneOf": [kind, {"type": "null"}]}
-    return dict(kind, description=s.help, **({"default": s.default} if s.default is not None
+    default = list(s.default) if isinstance(s.default, tuple) else s.default
+    return dict(kind, description=s.help, **({"default": default} if default is not None
                                              else {}))
 
 

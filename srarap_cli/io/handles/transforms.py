@@ -56,12 +56,12 @@ def _check_angle(ctx, key, value):
     """Warn where the unit looks mistaken: radians beyond a full turn (degrees meant), or
     ``angle``, whose unit the reader has to know."""
     if key == "angle_rad" and abs(value) > 2 * np.pi:
-        ctx.warn(f"angle_rad {value:g} is {np.degrees(value):g} degrees, more than a full "
+        ctx.warn("angle-unit", f"angle_rad {value:g} is {np.degrees(value):g} degrees, more than a full "
                  "turn: if degrees were meant, write angle_deg")
     elif key == "angle":
         hint = (" (a value this small looks like radians: write angle_rad if so)"
                 if 0 < abs(value) <= 2 * np.pi else "")
-        ctx.warn(f"angle {value:g} is read as degrees{hint}; write angle_deg or angle_rad "
+        ctx.warn("angle-unit", f"angle {value:g} is read as degrees{hint}; write angle_deg or angle_rad "
                  "to say which")
 
 
@@ -114,12 +114,12 @@ def _check_turn(ctx, spec):
         turns, rest = divmod(abs(degrees), 360.0)
         rest = min(rest, 360.0 - rest)
         if turns >= 1 and rest < 1e-9:
-            ctx.warn(f"{key} {value:g} is {int(turns)} whole turn(s): the targets are the rest "
-                     "pose and nothing turns (a static solve sees only where vertices end; "
-                     "keyframes turn it step by step)")
+            ctx.warn("whole-turns", f"{key} {value:g} is {int(turns)} whole turn(s): the "
+                     "targets are the rest pose and nothing turns (a static solve sees only "
+                     "where vertices end; keyframes turn it step by step)")
         elif abs(degrees) > 180:
             same = (degrees + 180.0) % 360.0 - 180.0
-            ctx.warn(f"{key} {value:g} reaches the same targets as {same:.6g} degrees: a static "
+            ctx.warn("short-way", f"{key} {value:g} reaches the same targets as {same:.6g} degrees: a static "
                      "solve sees only where vertices end and turns the short way (keyframes "
                      "turn it step by step)")
 
@@ -172,7 +172,7 @@ def check_reach(ctx: Context, rest: np.ndarray, moved: np.ndarray, diagonal: flo
         return
     reach = float(np.sqrt(np.max(np.einsum("ij,ij->i", moved - rest, moved - rest))))
     if reach > diagonal:
-        ctx.warn(f"{what} move vertices by up to {reach:.4g}, {reach / diagonal:.3g} times "
+        ctx.warn("units", f"{what} move vertices by up to {reach:.4g}, {reach / diagonal:.3g} times "
                  f"the mesh's bounding-box diagonal ({diagonal:.4g}): check the units")
 
 
@@ -194,7 +194,7 @@ def _moved(ctx, spec, rest, base):
         M = _matrix(ctx, spec["matrix"], base)
         why = not_rigid(M[:3, :3])
         if why:
-            ctx.warn(f"matrix {why}: no rigid motion reaches its targets, so the surface "
+            ctx.warn("not-rigid", f"matrix {why}: no rigid motion reaches its targets, so the surface "
                      "around the group is stretched or turned inside out")
         return rest @ M[:3, :3].T + M[:3, 3]
     if "pivot" in spec and "rotate" not in spec:

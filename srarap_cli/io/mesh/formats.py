@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...runtime.warning_codes import Note, as_note, note
 from .mesh import Mesh
 from .normals import recompute_normals
 from .obj import format_obj, obj_frames, read_obj
@@ -68,12 +69,14 @@ class MeshFormat:
 
     def encode(self, mesh: Mesh, ascii: bool = False) -> Written:
         """``write``'s bytes and warnings, with a warning for what the file ``mesh`` was read
-        from held and no writer keeps (:attr:`Mesh.unkept`)."""
+        from held and no writer keeps (:attr:`Mesh.unkept`); each one coded ``format-drops``
+        (a plug-in writer's plain lines too), so ``strict`` catches it."""
         data, lost = self.write(mesh, ascii)
         if mesh.unkept:
             lost = lost + [f"not written: {'; '.join(mesh.unkept)} of the input (srarap "
                            "keeps vertices, faces and per-vertex properties)"]
-        return data, lost
+        return data, [as_note(w) if isinstance(as_note(w), Note) else note("format-drops", w)
+                      for w in lost]
 
     def frame_writer(self, mesh: Mesh) -> Callable[[np.ndarray], bytes]:
         """``frame(positions) -> bytes``: the file of ``mesh`` with other positions (n, 3)."""

@@ -8,6 +8,7 @@ import numpy as np
 
 from ...runtime.commit import atomic_write
 from ...runtime.errors import OutputError, excerpt
+from ...runtime.warning_codes import as_note, note
 from .simplify import CoarseMesh, simplify_to_subset
 
 #: Names the entry layout and the simplifier's behaviour: change it when either changes.
@@ -43,12 +44,14 @@ def coarse_mesh(V: np.ndarray, F: np.ndarray, size: int, groups: list[np.ndarray
     if os.path.exists(path):
         try:
             with np.load(path) as z:
-                found = CoarseMesh(z["vertices"], z["faces"], [str(w) for w in z["warnings"]])
+                found = CoarseMesh(z["vertices"], z["faces"],
+                                   [as_note(str(w)) for w in z["warnings"]])
             if _consistent(found, len(V)):
                 return found, True, []
-            notes.append(f"{path}: inconsistent cache entry, simplifying again")
+            notes.append(note("cache-entry", f"{path}: inconsistent cache entry, simplifying again"))
         except (OSError, ValueError, KeyError) as exc:
-            notes.append(f"{path}: unreadable cache entry ({exc}), simplifying again")
+            notes.append(note("cache-entry",
+                              f"{path}: unreadable cache entry ({exc}), simplifying again"))
     coarse = simplify_to_subset(V, F, size, groups)
     try:
         os.makedirs(cache_dir, exist_ok=True)
@@ -57,10 +60,11 @@ def coarse_mesh(V: np.ndarray, F: np.ndarray, size: int, groups: list[np.ndarray
                  warnings=np.array(coarse.warnings, dtype=str))
         atomic_write(path, buf.getvalue())
     except (OSError, OutputError) as exc:
-        notes.append(f"{excerpt(cache_dir, 80)}: cannot write the cache ({excerpt(exc, 120)})")
+        notes.append(note("cache-unwritable", f"{excerpt(cache_dir, 80)}: cannot write the cache "
+                          f"({excerpt(exc, 120)})"))
     except RecursionError:  # os.makedirs recurses once per missing folder level
-        notes.append(f"{excerpt(cache_dir, 80)}: cannot write the cache (too many folder "
-                     "levels)")
+        notes.append(note("cache-unwritable", f"{excerpt(cache_dir, 80)}: cannot write the "
+                          "cache (too many folder levels)"))
     return coarse, False, notes
 
 

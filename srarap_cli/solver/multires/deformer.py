@@ -14,14 +14,16 @@ from numpy.typing import ArrayLike
 from ...runtime import memory
 from ...runtime.errors import NumericalError
 from ...runtime.parallel import using_threads
+from ...runtime.stages import ended as stage_ended
 from ...runtime.threads import background, single_threaded
+from ...runtime.warning_codes import note, reworded
 from .. import api_checks
 from ..deformer import ACCEL_DRIVERS, Deformer, solve_settings
 from ..drivers.anderson import anderson_iteration
 from ..group_rotations import connected_groups, group_rotors
 from ..mesh_checks import edge_adjacency
 from ..quaternion import IDENTITY
-from ..result import DeformResult, MultiresPart
+from ..result import STAGE_NAMES, DeformResult, MultiresPart
 from ..settings import Settings, with_keywords
 from ..starts import STARTS
 from ..stop import StopReason
@@ -56,6 +58,11 @@ class _Delayed:
     def __call__(self, state: Any, residual: np.ndarray) -> np.ndarray | None:
         assert self.correction is not None  # due() came first
         return self.correction(state, residual)
+
+
+def _ended(key, seconds):
+    """A stage's ``seconds``, said (``-v``) under the summary's name for it."""
+    return stage_ended(f"multires: {STAGE_NAMES[key]}", seconds)
 
 
 def _on_level(callback, level):
@@ -173,7 +180,7 @@ class MultiresDeformer:
     def _build_levels(self, size, groups, cache, built, start):
         """Everything of the setup but the full-resolution factorizations (see __init__)."""
         self.coarse, self.cache_hit, notes = coarse_mesh(self.V, self.F, size, groups, cache)
-        self.stages = {"simplify": time.perf_counter() - start}
+        self.stages = {"simplify": _ended("simplify", time.perf_counter() - start)}
         self._fine, self._own_setup = built.result(), 0.0
         self.area = self._fine.area
         self.direct = self._no_gain()
@@ -189,7 +196,7 @@ class MultiresDeformer:
         if self.mode != "refine":  # nothing left to factor beside the solve
             self._ready()
         self.warnings = (self._fine.warnings + notes
-                         + [f"multires: {w}" for w in self.coarse.warnings])
+                         + [reworded(w, "multires: ") for w in self.coarse.warnings])
 
     @property
     def fine(self) -> Deformer:
@@ -205,7 +212,7 @@ class MultiresDeformer:
         level for 11 s)."""
         if self._prepared is not None:
             seconds, self._prepared = self._prepared(), None
-            self.stages["factor"] = seconds + self._own_setup
+            self.stages["factor"] = _ended("factor", seconds + self._own_setup)
 
     def _settle(self):
         """After an error: wait for the full-resolution setup, its own outcome dropped, so
@@ -223,8 +230,9 @@ class MultiresDeformer:
         kept, used = self.coarse.vertices.size, np.unique(self.F).size
         if kept <= NO_GAIN * used:
             return None
-        self.fine.warnings.append(f"multires: the mesh simplifies only to {kept} of its {used} "
-                                  "vertices; solved at full resolution")
+        self.fine.warnings.append(note("multires-no-gain", f"multires: the mesh simplifies only "
+                                       f"to {kept} of its {used} vertices; solved at full "
+                                       "resolution"))
         return self.fine
 
     @classmethod
@@ -268,7 +276,8 @@ class MultiresDeformer:
         else:  # a level between: coarse-to-fine and corrections from a coarser mesh again
             self.coarse_deformer = MultiresDeformer.or_direct(
                 *args, labels, settings=self.settings, size=size, cache=cache, area=self.area)
-        self.stages["coarse_precompute"] = time.perf_counter() - start
+        self.stages["coarse_precompute"] = _ended("coarse_precompute",
+                                                  time.perf_counter() - start)
 
     def _build_transfer(self):
         """Dirichlet set (coarse, held and immovable vertices) and its factorization."""
@@ -312,19 +321,19 @@ class MultiresDeformer:
             raise
         coarse_seconds = time.perf_counter() - begin
         self._ready()
-        stages = dict(self.stages, coarse_solve=coarse_seconds)
+        stages = dict(self.stages, coarse_solve=_ended("coarse_solve", coarse_seconds))
         peaks = dict(self.memory, coarse_solve=memory.stop(peak))
         log = [dict(row, step="coarse-" + row["step"]) for row in coarse.log]
         if self.mode == "transfer":
             return self._transfer(targets, coarse, log, stages, begin, peaks)
         mark, peak = time.perf_counter(), memory.start()
         first = self._fine_start(targets, s.tol, coarse, start or s.start)
-        stages["fine_start"] = time.perf_counter() - mark
+        stages["fine_start"] = _ended("fine_start", time.perf_counter() - mark)
         peaks["fine_start"] = memory.stop(peak)
         mark, peak = time.perf_counter(), memory.start()
         fine = self.fine.solve(targets, initial=first, start="extrapolated", callback=callback,
                                driver=self._driver(targets, s.tol, s.accel), settings=s)
-        stages["fine_iterations"] = time.perf_counter() - mark
+        stages["fine_iterations"] = _ended("fine_iterations", time.perf_counter() - mark)
         peaks["fine_iterations"] = memory.stop(peak)
         offset, elapsed = len(log), mark - begin
         log += [dict(row, iteration=row["iteration"] + offset, seconds=row["seconds"] + elapsed)
@@ -401,11 +410,11 @@ class MultiresDeformer:
         """The paper's result: coarse rotors spread harmonically, one Poisson solve."""
         mark, peak = time.perf_counter(), memory.start()
         R = spread_rotors(self.solver, self._known_rotors(targets, coarse.rotors))
-        stages["transfer"] = time.perf_counter() - mark
+        stages["transfer"] = _ended("transfer", time.perf_counter() - mark)
         mark = time.perf_counter()
         P = self.solver.solve(self.known_positions(targets, coarse.positions),
                               self.fine.edges.rotated_divergence(R))
-        stages["fine_solve"] = time.perf_counter() - mark
+        stages["fine_solve"] = _ended("fine_solve", time.perf_counter() - mark)
         energy = self.fine.energy(P, R)
         if not (np.isfinite(P).all() and np.isfinite(energy["total"])):
             raise NumericalError("the full-resolution solve produced non-finite values")

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...runtime.warning_codes import note
 from .collapse import collapse_to
 from .topology import topology_summary
 
@@ -70,8 +71,8 @@ def simplify_to_subset(V: np.ndarray, F: np.ndarray, size: int,
     faces = faces.reshape(-1, 3)
     notes = _topology_warnings(F, faces, len(V), len(vertices))
     if len(vertices) > 1.5 * size and len(vertices) < used.sum():
-        notes.append(f"simplification stopped at {len(vertices)} vertices (asked {size}): "
-                     "no further collapse keeps the surface valid")
+        notes.append(note("coarse-size", f"simplification stopped at {len(vertices)} vertices "
+                          f"(asked {size}): no further collapse keeps the surface valid"))
     return CoarseMesh(vertices, faces, notes)
 
 
@@ -84,12 +85,12 @@ def _topology_warnings(F, G, n, m):
     fine, coarse = topology_summary(F, n), topology_summary(G, m)
     notes = []
     if fine["edge_manifold"] and not coarse["edge_manifold"]:
-        notes.append("the coarse mesh has non-manifold edges")
+        notes.append(note("coarse-topology", "the coarse mesh has non-manifold edges"))
     for key, what in (("euler", "Euler characteristic"), ("components", "connected parts"),
                       ("boundary_loops", "boundary loops")):
         if fine[key] != coarse[key]:
-            notes.append(f"the coarse mesh's {what} differ from the mesh's "
-                         f"({coarse[key]} vs {fine[key]})")
+            notes.append(note("coarse-topology", f"the coarse mesh's {what} differ from the "
+                              f"mesh's ({coarse[key]} vs {fine[key]})"))
     return notes
 
 
