@@ -49,6 +49,10 @@ def _run() -> int:
         signals.streams.release()
         sys.stderr.write(f"srarap: error: terminated; {_written()}\n")
         return 143
+    except Exception as exc:  # noqa: BLE001 -- past every command's own boundary: one line,
+        # not the silent exit 1 that leaving without the interpreter's teardown would give
+        sys.stderr.write(f"srarap: error: internal error: {type(exc).__name__}: {exc}\n")
+        return 1
 
 
 def _leave(code: int) -> None:

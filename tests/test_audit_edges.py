@@ -311,6 +311,8 @@ IDS = np.arange(10)
     (lambda: Deformer(V, F, IDS, labels=np.full(10, 0.5)), TypeError, "labels must hold"),
     (lambda: Deformer(V, F, IDS, labels=np.full(10, -1)), ValueError, "labels must be >= 0"),
     (lambda: Deformer(V, F, IDS).solve(V[IDS], driver="nope"), ValueError, "driver 'nope'"),
+    (lambda: Deformer(V, F, IDS).solve(V[IDS] + 1e200), ValueError,
+     "targets has coordinates beyond 1e+150"),  # was "Factor is exactly singular"
     (lambda: srarap_cli.read_mesh(12), TypeError, "path must be"),
 ])
 def test_api_mistakes_name_the_argument(call, kind, words):
@@ -514,3 +516,27 @@ def test_a_job_whose_output_was_deleted_runs_again(tmp_path):
     assert run_cli(["batch", manifest, "-o", out, "-q"]).returncode == 0
     assert json.loads((out / "summary.json").read_text())[0]["status"] == "ok"
     assert (out / "x.obj").read_bytes() == first
+
+
+@pytest.mark.parametrize("setting, value, words", [
+    ("tol", 18446744073709551616, None),  # a big tolerance is a valid (if loose) one
+    ("feedback", 18446744073709551616, "feedback must be <= 1e+12"),
+    ("alpha", 1e308, "alpha must be <= 1e+12"),
+    ("feedback", 1e308, "feedback must be <= 1e+12"),
+    ("max_iter", 2 ** 64, "max_iter must be <= 9007199254740992"),
+    ("threads", 2 ** 64, "threads must be <= 9007199254740992"),
+    ("tol", 10 ** 400, "tol must be finite"),
+])
+def test_settings_past_64_bits_or_past_what_a_solve_holds_are_exit_4(tmp_path, setting, value,
+                                                                     words):
+    """An integer past 64 bits (tol, feedback with sr-linear) was an internal error, exit 1;
+    feedback 1e308 a "singular system" blamed on the geometry (issue 61)."""
+    h = tmp_path / "h.yaml"
+    top = {**TOP, "translate": [0, 0, 1]}
+    h.write_text(json.dumps({"solver": {"method": "sr-linear", "max_iter": 50, setting: value},
+                             "groups": {"base": BASE, "top": top}}))
+    r = run_cli(["deform", BAR, h, "-o", tmp_path / "o.obj", "--keep-unconverged"])
+    if words is None:
+        assert r.returncode in (0, 3), r.stderr
+    else:
+        assert words in one_line(r, 4)

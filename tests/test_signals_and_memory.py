@@ -299,3 +299,38 @@ def test_a_reader_that_stops_early_is_a_broken_pipe_not_a_success(tmp_path, comm
         writer.wait(timeout=120)
         assert writer.returncode == 141, err
         assert "wrote" not in err and "Traceback" not in err
+
+
+BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
+BEND = os.path.join(ROOT, "configs", "bar-bend.yaml")
+TO_STDOUT = [["deform", BAR, BEND, "-o", "-", "--format", "obj"], ["info", BAR],
+             ["info", BAR, BEND, "--json"], ["bench", BAR, BEND, "--time-budget", "1"],
+             ["--help"], ["deform", "--help"], ["--version"]]
+
+
+@pytest.mark.parametrize("command", TO_STDOUT, ids=lambda c: " ".join(c[:1] + c[-1:]))
+def test_every_command_that_writes_to_stdout_exits_141_when_nobody_reads(command):
+    """The reader gone before the first write (its end closed): 141 and no "wrote" line,
+    from every command that writes to standard output, --help and --version too (they
+    exited 1 without a word)."""
+    read, write = os.pipe()
+    os.close(read)
+    try:
+        done = subprocess.run([sys.executable, "-m", "srarap_cli", *command], stdout=write,
+                              stderr=subprocess.PIPE, text=True, timeout=300)
+    finally:
+        os.close(write)
+    assert done.returncode == 141, done.stderr
+    assert "wrote" not in done.stderr and "Traceback" not in done.stderr
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full here")
+@pytest.mark.parametrize("command", TO_STDOUT, ids=lambda c: " ".join(c[:1] + c[-1:]))
+def test_every_command_that_writes_to_a_full_disk_says_so_in_one_line(command):
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-m", "srarap_cli", *command], stdout=full,
+                              stderr=subprocess.PIPE, text=True, timeout=300)
+    assert done.returncode == 6, done.stderr
+    assert done.stderr.splitlines()[-1] == ("srarap: error: <stdout>: cannot write: No space "
+                                            "left on device"), done.stderr
+    assert "Traceback" not in done.stderr

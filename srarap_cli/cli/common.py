@@ -12,7 +12,7 @@ import click
 import numpy as np
 
 from ..io.mesh import FORMATS, MeshFormat
-from ..runtime import exit_codes, signals, streams
+from ..runtime import descriptors, exit_codes, signals, streams
 from ..runtime.clock import elapsed
 from ..runtime.commit import COMMITTED
 from ..runtime.errors import OutputError
@@ -79,7 +79,7 @@ def guarded(func: Callable[..., None]) -> Callable[..., None]:
             raise
         except BrokenPipeError:
             # the reader went away (``| head``): end quietly, as a process killed by SIGPIPE
-            _quiet_stdout()
+            descriptors.quiet_stdout()
             sys.exit(exit_codes.BROKEN_PIPE)
         # the command's outermost boundary: anything unexpected still becomes one line and
         # exit code 1 (traceback with --debug), never a raw traceback in a user's pipeline
@@ -96,15 +96,6 @@ def guarded(func: Callable[..., None]) -> Callable[..., None]:
             fail(exit_codes.TERMINATED, f"terminated; {written()}")
 
     return wrapper
-
-
-def _quiet_stdout():
-    """Point stdout at /dev/null: flushing what the closed pipe did not take would fail."""
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-    except (OSError, ValueError):
-        pass
 
 
 def written() -> str:

@@ -8,7 +8,7 @@ import click
 from click.core import Command, Context
 from click.formatting import HelpFormatter
 
-from ..runtime import signals, streams
+from ..runtime import descriptors, exit_codes, signals, streams
 from ..runtime.lazy_modules import defer_unused_numpy_modules
 from ..runtime.threads import pin_process
 
@@ -79,6 +79,13 @@ class LazyGroup(click.Group):
         except click.ClickException as exc:
             click.echo(f"srarap: error: {exc.format_message()}", err=True)
             sys.exit(exc.exit_code)
+        except BrokenPipeError:  # --help or --version into a pipe whose reader went away
+            descriptors.quiet_stdout()
+            sys.exit(exit_codes.BROKEN_PIPE)
+        except OSError as exc:  # ... or onto a full disk (> /dev/full): one line, exit 6
+            click.echo(f"srarap: error: <stdout>: cannot write: {exc.strerror or exc}",
+                       err=True)
+            sys.exit(exit_codes.OUTPUT_ERROR)
         except (click.Abort, KeyboardInterrupt):
             signals.block()
             streams.release()

@@ -11,7 +11,7 @@ import click
 
 from ..runtime.warning_codes import CODES, REQUEST
 from ..solver.multires.size import parse_size
-from ..solver.settings import SETTINGS, Setting
+from ..solver.settings import MAX_INT, SETTINGS, Setting
 from .common import FiniteFloat
 
 #: a command function a decorator wraps
@@ -39,9 +39,10 @@ def setting_option(setting: Setting, default: object = None) -> Callable[[F], F]
                             help=text)
     elif setting.kind == "int":
         low = None if setting.minimum is None else int(setting.minimum)
-        kind = click.IntRange(min=low, min_open=setting.strict)
+        kind = click.IntRange(min=low, min_open=setting.strict,
+                              max=int(setting.maximum or MAX_INT))
     else:
-        kind = FiniteFloat(min=setting.minimum, min_open=setting.strict)
+        kind = FiniteFloat(min=setting.minimum, min_open=setting.strict, max=setting.maximum)
     return click.option(setting.flag, setting.name, type=kind, metavar=setting.metavar,
                         help=text)
 

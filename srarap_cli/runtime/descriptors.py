@@ -35,3 +35,13 @@ def reopen_closed() -> None:
 def closed(fd: int) -> bool:
     """Whether standard descriptor ``fd`` was closed when the process started."""
     return fd in CLOSED
+
+
+def quiet_stdout() -> None:
+    """Point stdout at the null device once its reader went away: flushing what the closed
+    pipe did not take would fail again at exit."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass

@@ -107,6 +107,9 @@ def targets(values: ArrayLike, k: int) -> np.ndarray:
                          f"in the order given, got shape {values.shape}")
     if not np.isfinite(values).all():
         raise ValueError("targets has NaN or infinite values")
+    if values.size and np.abs(values).max() > MAX_COORDINATE:  # a singular factor said so
+        raise ValueError(f"targets has coordinates beyond {MAX_COORDINATE:g} (their squares "
+                         "would overflow); rescale the mesh and the targets")
     return values
 
 

@@ -26,6 +26,10 @@ from .multires.size import AUTO_RATIO, AUTO_SIZE, AUTO_THRESHOLD, parse_size
 WEIGHT_KINDS = ("cotan", "cotan-clamped", "uniform")
 #: How the one-solve local steps get the rotors of constrained vertices (Deformer.handle_rotors).
 HANDLE_ROTORS = ("boundary", "lagged")
+#: the largest integer setting (iterations, threads): past it, numpy's integers overflow
+MAX_INT = 2 ** 53
+#: the largest weight (alpha, feedback): at 1e308 the systems' products overflow to infinity
+MAX_WEIGHT = 1e12
 
 
 @dataclass(frozen=True)
@@ -41,6 +45,8 @@ class Setting:
     help : str, one sentence for ``--help`` and the README
     stage : {"setup", "solve", "build", "run"}
     minimum : float or int, optional lower bound; ``strict`` excludes it
+    maximum : float or int, optional upper bound (included); an int setting is at most
+        :data:`MAX_INT` in any case
     choices : tuple of str, for ``choice``
     method : str, optional; the local step the setting belongs to (it is ignored by others)
     metavar : str, optional, shown in ``--help``
@@ -54,6 +60,7 @@ class Setting:
     help: str
     stage: str
     minimum: float | None = None
+    maximum: float | None = None
     strict: bool = False
     choices: tuple = ()
     method: str | None = None
@@ -90,20 +97,29 @@ class Setting:
         else:
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise error(f"{self.name} must be a number")
-            out = value  # as written: batch fingerprints hash the settings' JSON
-            if not math.isfinite(out):
+            try:  # an integer past 64 bits reached numpy as an object it cannot take
+                finite = math.isfinite(float(value))
+            except OverflowError:
+                finite = False
+            if not finite:
                 raise error(f"{self.name} must be finite")
+            out = value if isinstance(value, float) else float(value)
         if self.minimum is not None and (out <= self.minimum if self.strict
                                          else out < self.minimum):
             raise error(f"{self.name} must be {'>' if self.strict else '>='} {self.minimum:g}")
+        top = MAX_INT if self.kind == "int" and self.maximum is None else self.maximum
+        if top is not None and out > top:
+            raise error(f"{self.name} must be <= {top:g}" if isinstance(top, float)
+                        else f"{self.name} must be <= {top}")
         return out
 
 
 SETTINGS = (
     Setting("alpha", "float", 0.14, "Bending weight (energy uses alpha * total area).",
-            "setup", minimum=0, strict=True),
+            "setup", minimum=0, strict=True, maximum=MAX_WEIGHT),
     Setting("feedback", "float", 0.2,
-            "Pull of each rotor toward its previous value (paper's eps).", "setup", minimum=0),
+            "Pull of each rotor toward its previous value (paper's eps).", "setup", minimum=0,
+            maximum=MAX_WEIGHT),
     Setting("weights", "choice", "cotan-clamped", "Edge weights.", "setup",
             choices=WEIGHT_KINDS),
     Setting("method", "choice", "sr-linear-sym",

@@ -10,7 +10,7 @@ import json
 from typing import Any
 
 from ...runtime.warning_codes import CODES
-from ...solver.settings import SETTINGS
+from ...solver.settings import MAX_INT, SETTINGS
 from .keyframes import EASINGS
 from .keys import KEY_KEYS, STATIC_ACTIONS
 from .selectors import SELECTOR_KEYS
@@ -87,6 +87,8 @@ def _setting(s):
     kind = kinds[s.kind]
     if s.minimum is not None and s.kind in ("float", "int"):
         kind["exclusiveMinimum" if s.strict else "minimum"] = s.minimum
+    if s.kind in ("float", "int") and (s.maximum is not None or s.kind == "int"):
+        kind["maximum"] = s.maximum if s.maximum is not None else MAX_INT
     if s.default is None:
         kind = {"oneOf": [kind, {"type": "null"}]}
     default = list(s.default) if isinstance(s.default, tuple) else s.default
