@@ -312,7 +312,7 @@ IDS = np.arange(10)
     (lambda: Deformer(V, F, IDS, labels=np.full(10, -1)), ValueError, "labels must be >= 0"),
     (lambda: Deformer(V, F, IDS).solve(V[IDS], driver="nope"), ValueError, "driver 'nope'"),
     (lambda: Deformer(V, F, IDS).solve(V[IDS] + 1e200), ValueError,
-     "targets has coordinates beyond 1e+150"),  # was "Factor is exactly singular"
+     "targets has coordinates beyond 1e"),  # was "Factor is exactly singular"
     (lambda: srarap_cli.read_mesh(12), TypeError, "path must be"),
 ])
 def test_api_mistakes_name_the_argument(call, kind, words):
