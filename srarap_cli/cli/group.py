@@ -8,7 +8,7 @@ import click
 from click.core import Command, Context
 from click.formatting import HelpFormatter
 
-from ..runtime import descriptors, exit_codes, signals, streams
+from ..runtime import descriptors, exit_codes, limits, signals, streams
 from ..runtime.lazy_modules import defer_unused_numpy_modules
 from ..runtime.threads import pin_process
 
@@ -34,6 +34,11 @@ COMMANDS = {
 }
 
 
+def _leave_now(code: int, text: str) -> NoReturn:
+    click.echo(f"srarap: error: {text}", err=True)
+    sys.exit(code)
+
+
 class LazyGroup(click.Group):
     """A group whose commands are imported on first use."""
 
@@ -47,9 +52,18 @@ class LazyGroup(click.Group):
         # imports numpy: here, after main's BLAS thread settings, and not for ``srarap --help``;
         # with SIGINT/SIGTERM held back, since one raised inside numpy's class set-up surfaced
         # as a RuntimeError: it is raised once the imports are done
-        with signals.deferred():
-            defer_unused_numpy_modules()
-            found = getattr(importlib.import_module(f".{module}", __package__), attr)
+        try:
+            limits.check_start()
+            with signals.deferred():
+                defer_unused_numpy_modules()
+                found = getattr(importlib.import_module(f".{module}", __package__), attr)
+        except limits.InputError as exc:
+            _leave_now(exit_codes.INVALID_INPUT, str(exc))
+        except (MemoryError, ImportError, OSError) as exc:
+            if not (isinstance(exc, MemoryError) or limits.is_out_of_memory(exc)):
+                raise
+            _leave_now(exit_codes.INVALID_INPUT, "out of memory: srarap's libraries do not fit "
+                       f"in the memory this process may use ({limits.memory_note()})")
         return found
 
     def main(self, args: Sequence[str] | None = None, prog_name: str | None = None,  # type: ignore[override]

@@ -20,11 +20,16 @@ ENV = "SRARAP_MEMORY_LIMIT"
 #: coordinates beyond this would overflow when squared (energies, lengths): a typo, not a pose
 MAX_COORDINATE = 1e150
 # an address space holds the interpreter and its libraries before any data: 205-290 MB of
-# mappings (VmSize) once numpy, scipy, libigl, yaml and click are loaded
+# mappings (VmSize) once numpy, scipy, libigl, yaml and click are loaded (where the mappings
+# cannot be read, this is assumed)
 ADDRESS_SPACE_BASE = 300_000_000
+# what the address space must keep free beyond the data: OpenBLAS maps its work buffers
+# (32 MiB and more) at its first call and, when it cannot, prints "Memory allocation still
+# failed after 10 retries, giving up" and ends the process with code 1 (ulimit -v 400000)
+BLAS_RESERVE = 128_000_000
 # SuperLU and libigl report a failed allocation in their own words
 _OOM_WORDS = ("malloc", "out of memory", "not enough memory", "bad_alloc", "cannot allocate",
-              "can't start new thread")
+              "can't start new thread", "failed to map segment")
 #: a thread a library could not start (libigl's, under ``ulimit -v``: pthread_create's EAGAIN
 #: as a RuntimeError); as an OSError the same words are a busy pipe, not memory
 _THREAD_WORDS = ("resource temporarily unavailable",)
@@ -57,8 +62,29 @@ def _system_available():
 
 
 def _address_space():
+    """What ``ulimit -v`` leaves for data: the limit less what is mapped now (the libraries
+    loaded, the data read) and :data:`BLAS_RESERVE`; None without a limit."""
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
-    return None if soft == resource.RLIM_INFINITY else max(soft - ADDRESS_SPACE_BASE, 0)
+    if soft == resource.RLIM_INFINITY:
+        return None
+    mapped = status_bytes("VmSize")
+    return max(soft - (ADDRESS_SPACE_BASE if mapped is None else mapped) - BLAS_RESERVE, 0)
+
+
+#: the address space srarap needs to load its libraries and start BLAS: below about 400 MB
+#: (``ulimit -v``) an import failed ("failed to map segment"), ran out of memory, or spun in
+#: OpenBLAS's allocation retries with SIGTERM held back (an import's signals wait for its end)
+MIN_START = 420_000_000
+
+
+def check_start() -> None:
+    """Refuse to load the numeric libraries in an address space too small for them (exit 4,
+    one line), before an import can fail or hang there."""
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft != resource.RLIM_INFINITY and soft < MIN_START:
+        raise InputError(f"out of memory: ulimit -v allows {_amount(soft)} of address space; "
+                         f"srarap needs at least {_amount(MIN_START)} to load numpy, scipy and "
+                         "libigl (raise ulimit -v)")
 
 
 def address_space_left() -> int | None:
@@ -112,17 +138,22 @@ def memory_note() -> str:
 def is_out_of_memory(exc: BaseException) -> bool:
     """Whether ``exc`` is a failed allocation reported as something else (SuperLU's malloc
     failures arrive as RuntimeError, C++'s bad_alloc as various types, a thread that could
-    not get its stack as RuntimeError)."""
+    not get its stack as RuntimeError, a library that could not be mapped as ImportError)."""
     text = str(exc).lower()
-    return isinstance(exc, (RuntimeError, OSError, ValueError)) and any(
+    return isinstance(exc, (RuntimeError, OSError, ValueError, ImportError)) and any(
         word in text for word in _OOM_WORDS) or (isinstance(exc, OSError) and exc.errno == 12) \
         or (type(exc) is RuntimeError and any(word in text for word in _THREAD_WORDS))
 
 
 def _refuse(what, need, have):
-    raise InputError(f"{what} needs about {need / 1e9:.1f} GB of memory, "
-                     f"{have / 1e9:.1f} GB available to it ({memory_note()}; set {ENV} to "
-                     "change the assumption)")
+    raise InputError(f"{what} needs about {_amount(need)} of memory, {_amount(have)} "
+                     f"available to it ({memory_note()}; set {ENV} to change the assumption)")
+
+
+def _amount(n):
+    """Bytes as a reader wants them: 1.2 GB, 48 MB, 20 kB ("0.0 GB" said nothing)."""
+    return (f"{n / 1e9:.1f} GB" if n >= 1e9 else f"{n / 1e6:.0f} MB" if n >= 1e6
+            else f"{n / 1e3:.0f} kB")
 
 
 def check_read(path: str | os.PathLike, factor: float) -> None:

@@ -17,14 +17,15 @@ import gzip
 import importlib.util
 import io
 import os
-import shutil
 import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...runtime.bounded import OutOfMemory, OutOfTime, run_bounded, time_bound
 from ...runtime.errors import InputError
+from ...runtime.limits import available_memory, memory_note
 from .formats import MeshFormat, Written, register_format
 from .mesh import Mesh
 
@@ -153,19 +154,35 @@ def _never(head: bytes, size: int | None) -> bool:
 
 def _reader(name, spec):
     def read(path: str) -> Mesh:
-        # the format's own reader (dolfin-xml's is meshio.dolfin): meshio.read prints and
-        # exits the process when it fails
-        reader = importlib.import_module(f"meshio.{name.removesuffix('-xml')}").read
+        seconds = time_bound(os.path.getsize(path))
         try:
-            with _quiet():
-                m = _gunzipped(reader, path, spec) if spec.gzip else reader(path)
-        except (MemoryError, FileNotFoundError, PermissionError, IsADirectoryError):
-            raise
-        except Exception as exc:  # meshio's parsers fail on a bad file with any error at all
-            raise InputError(f"{path}: not a readable {spec.display} file "
-                             f"({type(exc).__name__}: {str(exc)[:120]})") from None
-        return _surface(m, path, spec.own_data)
+            return run_bounded(_read, name, spec, path, seconds=seconds,
+                               memory=available_memory())
+        except OutOfTime:
+            raise InputError(f"{path}: meshio's {spec.display} reader did not finish in "
+                             f"{seconds:.0f} s; stopped (a truncated or damaged file?)") from None
+        except OutOfMemory:
+            raise InputError(f"{path}: reading it needs more memory than srarap may use "
+                             f"({memory_note()}): a count the file declares is too large "
+                             "for it (a damaged file?)") from None
     return read
+
+
+def _read(name, spec, path):
+    """The file read by meshio's reader of ``name`` (in a bounded child process: see
+    :mod:`srarap_cli.runtime.bounded`), as a :class:`Mesh`."""
+    # the format's own reader (dolfin-xml's is meshio.dolfin): meshio.read prints and exits
+    # the process when it fails
+    reader = importlib.import_module(f"meshio.{name.removesuffix('-xml')}").read
+    try:
+        with _quiet():
+            m = _gunzipped(reader, path, spec) if spec.gzip else reader(path)
+        return _surface(m, path, spec.own_data)  # what it read may hold anything too
+    except (MemoryError, FileNotFoundError, PermissionError, IsADirectoryError, InputError):
+        raise
+    except Exception as exc:  # meshio's parsers fail on a bad file with any error at all
+        raise InputError(f"{path}: not a readable {spec.display} file "
+                         f"({type(exc).__name__}: {str(exc)[:120]})") from None
 
 
 def _quiet():
@@ -175,12 +192,24 @@ def _quiet():
     return contextlib.redirect_stderr(io.StringIO())
 
 
+#: a compressed mesh may decompress to this many times its size at most (text meshes
+#: compress 3-10 times; gzip's own limit is about 1000)
+MAX_RATIO, MIN_UNPACKED = 100, 64 << 20
+
+
 def _gunzipped(reader, path, spec):
-    """``reader`` of the decompressed file (meshio's PERMAS reader reads no gzip)."""
+    """``reader`` of the decompressed file (meshio's PERMAS reader reads no gzip), its size
+    bounded (a 2 MiB file wrote 2 GiB into the temporary folder)."""
+    bound = max(MIN_UNPACKED, MAX_RATIO * os.path.getsize(path))
     with gzip.open(path, "rb") as packed, tempfile.TemporaryDirectory(prefix="srarap-") as dir:
         plain = os.path.join(dir, "mesh" + spec.extensions[0].removesuffix(".gz"))
         with open(plain, "wb") as out:
-            shutil.copyfileobj(packed, out)
+            while chunk := packed.read(1 << 20):
+                if out.tell() + len(chunk) > bound:
+                    raise InputError(f"{path}: decompresses to more than {bound >> 20} MiB "
+                                     f"({MAX_RATIO} times its size): not a mesh srarap reads "
+                                     "(a damaged or hostile file?)")
+                out.write(chunk)
         return reader(plain)
 
 

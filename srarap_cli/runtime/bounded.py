@@ -1,0 +1,149 @@
+"""Run code srarap does not own (a third-party file reader) where it cannot take srarap with
+it: in a child process with a bound on its time and its memory, which srarap kills when the
+bound is passed or when srarap itself is told to stop.
+
+meshio's Tecplot and MDPA readers loop forever on a truncated file, h5py hangs on a damaged
+HDF5 file ignoring SIGTERM and SIGINT, and a count a file declares (4,294,967,295 points in a
+2 KB VTK file) is allocated before anything checks it. In a child, the loop ends at the time
+bound, the hang ends with the child (SIGKILL, which nothing ignores) while srarap exits
+130/143 with its one line, and the allocation fails against the child's address-space limit
+instead of taking the machine's memory.
+
+The child is forked (the reader's modules are loaded already: no start-up cost) and sends its
+result back pickled through a pipe; without ``os.fork`` (or with ``SRARAP_BOUNDED=0``) the
+call runs in this process, unbounded.
+"""
+import os
+import pickle
+import select
+import signal
+import time
+from collections.abc import Callable
+from typing import Any
+
+#: seconds a bounded call may take at least, and per megabyte of its input on top
+#: (``SRARAP_READ_SECONDS`` replaces the first: tests of hostile files use a short one)
+BASE_SECONDS, SECONDS_PER_MB = 20.0, 2.0
+ENV_SECONDS, ENV_OFF = "SRARAP_READ_SECONDS", "SRARAP_BOUNDED"
+
+
+class OutOfTime(Exception):
+    """The call passed its time bound (and its process was killed)."""
+
+
+class OutOfMemory(Exception):
+    """The call needed more memory than its bound (an allocation failed in its process)."""
+
+
+def time_bound(size_bytes: int) -> float:
+    """Seconds a read of ``size_bytes`` may take: the base (``$SRARAP_READ_SECONDS`` where it
+    is a positive number) plus :data:`SECONDS_PER_MB` a megabyte."""
+    try:
+        base = float(os.environ.get(ENV_SECONDS, ""))
+    except ValueError:
+        base = BASE_SECONDS
+    base = base if base > 0 else BASE_SECONDS
+    return base + SECONDS_PER_MB * size_bytes / 1e6
+
+
+def run_bounded(func: Callable[..., Any], *args: Any, seconds: float,
+                memory: int | None) -> Any:
+    """``func(*args)`` in a child process given ``seconds`` and ``memory`` bytes of address
+    space beyond what it starts with (None: no memory bound). Returns its result or raises
+    its exception (both pickled back); raises :class:`OutOfTime` or :class:`OutOfMemory`
+    past a bound. A signal that ends this process kills the child first."""
+    if not hasattr(os, "fork") or os.environ.get(ENV_OFF) == "0":
+        return func(*args)
+    read, write = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: never returns
+        os.close(read)
+        _child(write, func, args, memory)
+    os.close(write)
+    data = None
+    try:
+        data = _collect(read, seconds)
+    finally:
+        os.close(read)
+        _reap(pid, kill=data is None)
+    kind, value = pickle.loads(data) if data else ("died", None)
+    if kind == "ok":
+        return value
+    if kind == "memory":
+        raise OutOfMemory(value)
+    if kind == "error":
+        raise value
+    raise OutOfMemory("the reading process ended without a result (killed for memory?)")
+
+
+def _child(write: int, func: Callable[..., Any], args: tuple, memory: int | None) -> None:
+    code = 0
+    try:
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(signum, signal.SIG_DFL)
+        _limit_memory(memory)
+        try:
+            out = ("ok", func(*args))
+        except MemoryError as exc:
+            out = ("memory", str(exc))
+        except Exception as exc:  # noqa: BLE001 -- carried to the parent, raised there
+            out = ("error", exc)
+        try:
+            data = pickle.dumps(out, protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception as exc:  # noqa: BLE001 -- an exception that does not pickle
+            data = pickle.dumps(("error", RuntimeError(f"{type(exc).__name__}: {exc}")))
+        with os.fdopen(write, "wb") as out_file:
+            out_file.write(data)
+    except BaseException:  # noqa: BLE001 -- the child ends here whatever happened
+        code = 1
+    finally:
+        os._exit(code)
+
+
+def _limit_memory(memory: int | None) -> None:
+    if memory is None:
+        return
+    import resource
+
+    now = _address_space_used()
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    want = now + memory
+    if hard != resource.RLIM_INFINITY:
+        want = min(want, hard)
+    if soft == resource.RLIM_INFINITY or want < soft:
+        resource.setrlimit(resource.RLIMIT_AS, (want, hard))
+
+
+def _address_space_used() -> int:
+    try:
+        with open("/proc/self/statm") as fh:
+            return int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
+def _collect(read: int, seconds: float) -> bytes:
+    """Everything the child writes, until it closes the pipe; OutOfTime past ``seconds``."""
+    chunks, end = [], time.monotonic() + seconds
+    while True:
+        left = end - time.monotonic()
+        if left <= 0:
+            raise OutOfTime(f"not done in {seconds:.0f} s")
+        ready, _, _ = select.select([read], [], [], min(left, 1.0))
+        if not ready:
+            continue
+        chunk = os.read(read, 1 << 20)
+        if not chunk:
+            return b"".join(chunks)
+        chunks.append(chunk)
+
+
+def _reap(pid: int, kill: bool) -> None:
+    """Wait for the child (no zombie left); ``kill`` it first where it did not finish (past
+    its bound, or this process was told to stop)."""
+    try:
+        if kill:
+            os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+    except (ChildProcessError, ProcessLookupError):
+        pass
