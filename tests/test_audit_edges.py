@@ -540,3 +540,23 @@ def test_settings_past_64_bits_or_past_what_a_solve_holds_are_exit_4(tmp_path, s
         assert r.returncode in (0, 3), r.stderr
     else:
         assert words in one_line(r, 4)
+
+
+def test_batch_refuses_an_unwritable_summary_before_solving_any_job(tmp_path):
+    """``batch -o`` where the summary cannot be written solved every job first (issue 61)."""
+    manifest = tmp_path / "jobs.yaml"
+    manifest.write_text(json.dumps({"jobs": [{"mesh": BAR, "handles": TWIST,
+                                              "output": "a.obj"}]}))
+    (tmp_path / "out" / "summary.csv").mkdir(parents=True)
+    r = run_cli(["batch", manifest, "-o", tmp_path / "out"])
+    assert "summary.csv: is a folder" in one_line(r, 6)
+    assert not (tmp_path / "out" / "a.obj").exists()
+
+
+def test_info_writes_control_characters_of_group_names_out_as_deform_does(tmp_path):
+    h = tmp_path / "h.yaml"
+    h.write_text(json.dumps({"groups": {"fix\x1b[31mRED\n2": BASE,
+                                        "top": {**TOP, "translate": [0, 0, 1]}}}))
+    r = run_cli(["info", BAR, h])
+    assert r.returncode == 0 and "\x1b" not in r.stdout
+    assert "  fix\\x1b[31mRED\\n2: " in r.stdout

@@ -316,6 +316,7 @@ def test_a_signal_stops_a_batch_within_seconds_with_a_true_summary(slow_batch, s
     if (out / "summary.json").exists():  # a signal before the jobs were read writes none
         rows = json.loads((out / "summary.json").read_text())
         assert {r["status"] for r in rows} <= {"ok", "interrupted"}
+        assert all(r["exit_code"] == code for r in rows if r["status"] == "interrupted")
         assert all((out / f"o{r['job'][1:]}.obj").exists() for r in rows if r["status"] == "ok")
     for _ in range(50):  # workers a starting cluster forked after the signal end too
         left = subprocess.run(["pgrep", "-g", str(p.pid)], capture_output=True).stdout
@@ -324,6 +325,33 @@ def test_a_signal_stops_a_batch_within_seconds_with_a_true_summary(slow_batch, s
         time.sleep(0.1)
     assert left == b"", "processes left behind"
 
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT])
+@pytest.mark.parametrize("extra", [[], ["--scheduler", "local"]])
+def test_a_job_committed_just_before_the_signal_is_ok_in_the_summary(slow_batch, signum,
+                                                                      extra):
+    """Issue 61: under Dask a job committed 0.1-0.6 s before the signal was "interrupted" (or
+    "up-to-date": the restarted worker ran it again and found its outputs)."""
+    out = slow_batch / f"out-{time.monotonic_ns()}"
+    p = subprocess.Popen([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o",
+                          str(out), "--workers", "2", *extra], cwd=slow_batch,
+                         stderr=subprocess.PIPE, start_new_session=True)
+    deadline = time.monotonic() + 120
+    while not (out.is_dir() and any(f.name.endswith(".srarap.json") for f in out.iterdir())):
+        assert time.monotonic() < deadline and p.poll() is None
+        time.sleep(0.01)
+    time.sleep(0.2)
+    os.killpg(p.pid, signum)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == {signal.SIGINT: 130, signal.SIGTERM: 143}[signum], err.decode()
+    rows = json.loads((out / "summary.json").read_text())
+    for r in rows:
+        on_disk = (out / f"o{r['job'][1:]}.obj.srarap.json").exists()
+        assert (r["status"] == "ok") == on_disk, (r, err.decode()[-400:])
+        assert r["status"] in ("ok", "interrupted"), r
+    assert rows[0]["status"] == "ok"
 
 
 # a batch worker, just forked and still in multiprocessing's start-up, sends the signal to

@@ -19,7 +19,7 @@ from ..tasks.batch.rows import BatchInterrupted
 from ..tasks.batch.run import run_batch
 from ..tasks.job_status import SUMMARY_FIELDS, WARNING_JOIN, JobStatus
 from ..tasks.preflight import check_output_path
-from .common import guarded, say
+from .common import guarded, printable, say
 from .options import StrictCommand, setting_option
 
 #: a Dask scheduler address: protocol://host:port, or host:port
@@ -77,6 +77,8 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         os.makedirs(out, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
+    for name in ("summary.csv", "summary.json"):  # before solving, as deform checks its -o
+        check_output_path(os.path.join(out, name), None, "summary")
     try:
         rows, stopped = run_batch(jobs, out, workers, scheduler, keep_unconverged,
                                   pictures=report is not None, threads=threads), None
@@ -136,18 +138,6 @@ def _tell(rows, out, quiet, stopped):
         note = (f"; {word}: the jobs not finished are marked interrupted in "
                 f"{os.path.join(out, 'summary.csv')}")
     say(f"srarap batch: {len(rows)} jobs: {summary}{note}")
-
-
-def printable(text: str) -> str:
-    r"""``text`` for one line of a terminal: control characters (an ESC sequence, a newline)
-    written out, so a job's name can neither colour the terminal nor break the table.
-
-    Examples
-    --------
-    >>> printable("bar\x1b[31m\nred")
-    'bar\\x1b[31m\\nred'
-    """
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def _csv(rows):

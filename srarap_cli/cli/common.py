@@ -33,13 +33,26 @@ def fail(code: int, message: str) -> NoReturn:
 
 
 def say(text: str) -> None:
-    """One line on standard error: a summary, a warning, a table row. A standard error that
-    cannot take it (a full device, a closed pipe) loses the line, not the run, whose
-    outputs and exit code stand."""
+    """One line on standard error: a summary, a warning, a table row, its control characters
+    written out (:func:`printable`: a group or job name from a file can neither colour the
+    terminal nor break the line). A standard error that cannot take it (a full device, a
+    closed pipe) loses the line, not the run, whose outputs and exit code stand."""
     try:
-        click.echo(text, err=True)
+        click.echo(printable(text), err=True)
     except OSError:
         pass
+
+
+def printable(text: str) -> str:
+    r"""``text`` for one line of a terminal: control characters (an ESC sequence, a newline)
+    written out.
+
+    Examples
+    --------
+    >>> printable("bar\x1b[31m\nred")
+    'bar\\x1b[31m\\nred'
+    """
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def write_stdout(data: bytes) -> None:

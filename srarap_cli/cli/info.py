@@ -7,7 +7,7 @@ from ..io.mesh.formats import MeshFormat
 from ..runtime.encoding import utf8
 from ..tasks.info import handles_info, mesh_info
 from ..tasks.preflight import load_posed, read_any_mesh
-from .common import guarded, input_format_option, pose_options, write_stdout
+from .common import guarded, input_format_option, pose_options, printable, write_stdout
 
 
 @click.command("info")
@@ -59,4 +59,4 @@ def _text(d):
             lines.append(f"  overlap: {o['vertices']} vertices in both "
                          f"{o['groups'][0]!r} and {o['groups'][1]!r}")
         lines += [f"  warning: {w}" for w in d["warnings"]]
-    return "\n".join(lines)
+    return "\n".join(map(printable, lines))  # names from the files: no control characters

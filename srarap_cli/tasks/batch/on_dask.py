@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 from ...runtime.environment import environ_changed
 from ...runtime.errors import InputError
-from ...runtime.signals import Terminated
+from ...runtime.signals import Terminated, block
 from ...runtime.threads import worker_processes
 from ..job_status import JobResult
 from .rows import BatchInterrupted, Job, interrupted_row, unfinished_row
@@ -72,6 +72,13 @@ def run_on_dask(jobs: list[Job], run: "functools.partial[JobResult]", scheduler:
                 raise
         try:
             return _gather_at(cluster, jobs, run, scheduler, unfinished)
+        except _Stopped as stop:
+            # the workers end before the disk is read: a task inside its commit when the
+            # signal came finishes it or not, and the summary says which (it read the disk
+            # while the task still wrote, and called a committed job interrupted)
+            block()
+            cluster.close()
+            raise stop.rows(jobs, unfinished) from None
         finally:
             cluster.close()
 
@@ -82,9 +89,26 @@ def _gather_at(cluster, jobs, run, scheduler, unfinished):
     from distributed import Client
 
     try:
-        return _gather(Client(cluster, timeout=30), jobs, run, unfinished)
+        return _gather(Client(cluster, timeout=30), jobs, run)
     except (OSError, TimeoutError) as exc:
         raise InputError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+    except _Stopped as stop:
+        if scheduler == "local":
+            raise  # its cluster is closed first (run_on_dask)
+        raise stop.rows(jobs, unfinished) from None  # a remote cluster's workers go on
+
+
+class _Stopped(BaseException):
+    """A signal stopped the gather: the rows of the tasks that finished (None for the
+    others) and the signal's exception."""
+
+    def __init__(self, finished: list[JobResult | None], signal: BaseException) -> None:
+        super().__init__("stopped")
+        self.finished, self.signal = finished, signal
+
+    def rows(self, jobs: list[Job], unfinished: Callable[[Job], JobResult]) -> BatchInterrupted:
+        return BatchInterrupted([row if row is not None else unfinished(job)
+                                 for row, job in zip(self.finished, jobs)], self.signal)
 
 
 def _without_dasks_trim_setting():
@@ -103,7 +127,7 @@ def _silence_dask():
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
-def _gather(client, jobs, run, unfinished):
+def _gather(client, jobs, run):
     """The rows of ``jobs`` run on ``client``'s cluster. A job Dask gave up on (its worker
     died each time it ran it: Dask's KilledWorker) is a failed row, not the batch's end."""
     with client:
@@ -116,10 +140,9 @@ def _gather(client, jobs, run, unfinished):
                 rows.append(_dask_row(future, job))
         except (KeyboardInterrupt, Terminated) as exc:
             _silence_dask()
-            rows = [f.result() if f.status == "finished" else unfinished(job)
-                    for f, job in zip(futures, jobs)]
+            finished = [f.result() if f.status == "finished" else None for f in futures]
             client.cancel(futures)
-            raise BatchInterrupted(rows, exc) from None
+            raise _Stopped(finished, exc) from None
         return rows
 
 

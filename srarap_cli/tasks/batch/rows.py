@@ -3,6 +3,8 @@ died), and the interruption that carries every job's result."""
 import os
 from typing import Any
 
+from ...runtime import exit_codes
+from ...runtime.signals import Terminated
 from ..job import DeformJob, JobResult, JobStatus, recorded_result
 from ..job_record import sidecar_path
 from .worker_pool import death_note
@@ -19,6 +21,10 @@ class BatchInterrupted(BaseException):
     def __init__(self, rows: list[JobResult], signal: BaseException) -> None:
         super().__init__("interrupted")
         self.rows, self.signal = rows, signal
+        code = exit_codes.TERMINATED if isinstance(signal, Terminated) else exit_codes.INTERRUPTED
+        for row in rows:  # a job SIGTERM stopped says 143, as the batch's exit does (not 130)
+            if row.status is JobStatus.INTERRUPTED:
+                row.exit_code = code
 
 
 def deform_job(job: Job, out_dir: str, keep_unconverged: bool = False) -> DeformJob:
@@ -50,6 +56,22 @@ def interrupted_row(job: Job, out_dir: str | None = None, keep_unconverged: bool
         return done
     return JobResult(job["name"], JobStatus.INTERRUPTED, JobStatus.INTERRUPTED.exit_code,
                      message="not finished: the batch was interrupted")
+
+
+def solved_since(row: JobResult, job: Job, out_dir: str, since: float) -> JobResult:
+    """``row``, an ``up-to-date`` job's, as ``ok`` where its record was written after
+    ``since`` (the batch's start): this batch solved it, and a second run of it found its
+    own outputs (a Dask worker that a signal or a crash stopped after the commit, its task
+    run again). Other rows as they are."""
+    if row.status is not JobStatus.UP_TO_DATE:
+        return row
+    try:
+        fresh = os.path.getmtime(sidecar_path(deform_job(job, out_dir).output)) >= since
+    except OSError:
+        fresh = False
+    if fresh:
+        row.status, row.exit_code, row.solved = JobStatus.OK, JobStatus.OK.exit_code, True
+    return row
 
 
 def lost_row(job: Job, exitcode: int) -> JobResult:

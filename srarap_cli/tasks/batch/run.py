@@ -28,7 +28,7 @@ from ..job import JobResult, run_job_safely
 from .job_pictures import difference_picture, energy_picture, shape_picture
 from .on_dask import run_on_dask
 from .report import encode_png
-from .rows import BatchInterrupted, Job, deform_job, interrupted_row, lost_row
+from .rows import BatchInterrupted, Job, deform_job, interrupted_row, lost_row, solved_since
 from .worker_pool import PoolStopped, run_in_processes
 
 
@@ -93,10 +93,20 @@ def run_batch(jobs: list[Job],
 
     The Dask workers must see the same files as this process (a shared file system).
     """
+    since = time.time()
     run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged,
                             pictures=pictures, threads=job_threads(workers, threads))
     unfinished = functools.partial(interrupted_row, out_dir=out_dir,
-                                   keep_unconverged=keep_unconverged, since=time.time())
+                                   keep_unconverged=keep_unconverged, since=since)
+    try:
+        rows = _rows(jobs, run, workers, scheduler, unfinished)
+    except BatchInterrupted as exc:
+        exc.rows = [solved_since(row, job, out_dir, since) for row, job in zip(exc.rows, jobs)]
+        raise
+    return [solved_since(row, job, out_dir, since) for row, job in zip(rows, jobs)]
+
+
+def _rows(jobs, run, workers, scheduler, unfinished):
     if scheduler is not None:
         return run_on_dask(jobs, run, scheduler, workers, unfinished)
     if workers <= 1:
