@@ -560,3 +560,21 @@ def test_info_writes_control_characters_of_group_names_out_as_deform_does(tmp_pa
     r = run_cli(["info", BAR, h])
     assert r.returncode == 0 and "\x1b" not in r.stdout
     assert "  fix\\x1b[31mRED\\n2: " in r.stdout
+
+
+@pytest.mark.parametrize("command", [
+    lambda tmp: ["animate", BAR, tmp / "missing.yaml", "-o", tmp / "frames" / "f_{}.obj"],
+    lambda tmp: ["bench", BAR, tmp / "missing.yaml", "-o", tmp / "frames"],
+])
+def test_a_failed_animate_or_bench_leaves_no_folder_it_made(tmp_path, command):
+    r = run_cli(command(tmp_path))
+    assert r.returncode == 4, r.stderr
+    assert not (tmp_path / "frames").exists()
+
+
+def test_a_short_animation_in_a_log_prints_no_progress_line(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "srarap_cli", "animate", BAR,
+                        os.path.join(ROOT, "configs", "bar-twist-animated.yaml"), "-o",
+                        str(tmp_path / "f_{}.obj"), "--frames", "3"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "progress" not in r.stderr, r.stderr

@@ -178,3 +178,33 @@ def test_one_pentagon_among_quads_splits_only_itself(name, tmp_path):
                     "triangles and quads) [format-drops]"]
     back = read_mesh(tmp_path / f"m{FORMATS[name].extension}")
     assert (back.face_sizes == 4).sum() == len(quads) - 1 and (back.face_sizes == 3).sum() == 3
+
+
+def test_a_full_temporary_folder_names_itself_and_tmpdir(tmp_path, monkeypatch):
+    """meshio writes a file: a full TMPDIR said "No space left on device" naming nothing
+    (issue 61)."""
+    import errno
+    import tempfile
+
+    from srarap_cli.runtime.errors import OutputError
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(tempfile, "TemporaryDirectory", full)
+    with pytest.raises(OutputError, match=r"cannot write the VTU file meshio makes there "
+                       r"\(No space left on device\); set TMPDIR"):
+        FORMATS["vtu"].encode(read_mesh(BAR))
+
+
+def test_an_unconverged_run_that_writes_no_mesh_does_not_encode_it(tmp_path, monkeypatch):
+    """... and such a run ended in exit 6 there, where it writes no mesh (exit 3)."""
+    from srarap_cli.io.mesh.formats import MeshFormat
+
+    def refuse(self, mesh, ascii=False):
+        raise AssertionError("encoded a mesh that is not written")
+
+    monkeypatch.setattr(MeshFormat, "encode", refuse)
+    r = run_cli(["deform", BAR, TWIST, "-o", tmp_path / "o.vtu", "--max-iter", "2"])
+    assert r.returncode == 3, r.stderr
+    assert not (tmp_path / "o.vtu").exists()

@@ -8,13 +8,12 @@ from ..io.handles import load_handles
 from ..io.mesh import read_mesh
 from ..runtime.commit import commit_files
 from ..runtime.encoding import utf8
-from ..runtime.errors import OutputError
 from ..runtime.limits import check_solve
 from ..solver.settings import resolve
 from ..tasks.bench import ALL_METHODS, IGL, run_methods
 from ..tasks.bench_report import curves_csv, plot_png, summary_json, table
 from ..tasks.pipeline import problem
-from ..tasks.preflight import refuse_overwrite
+from ..tasks.preflight import check_output_path, refuse_overwrite
 from .common import FiniteFloat, guarded, write_stdout
 from .options import settings_options
 
@@ -54,7 +53,8 @@ def bench(mesh: str, handles: str, methods: str, time_budget: float, out: str | 
     if out is not None:
         refuse_overwrite([os.path.join(out, name) for name in BENCH_FILES], mesh=mesh,
                          handles=handles)
-        _prepare_folder(out)
+        for name in BENCH_FILES:  # checked, not made: the commit makes it at the end
+            check_output_path(os.path.join(out, name), None, "-o")
     source = read_mesh(mesh)
     check_solve(mesh, len(source.vertices))
     constraints = load_handles(handles, source.vertices, any_rate=True)
@@ -72,10 +72,3 @@ def bench(mesh: str, handles: str, methods: str, time_budget: float, out: str | 
                     plot_png(runs, title))
         commit_files([(os.path.join(out, name), data)
                       for name, data in zip(BENCH_FILES, payloads)])
-
-
-def _prepare_folder(out):
-    try:
-        os.makedirs(out, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None

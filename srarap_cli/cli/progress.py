@@ -78,12 +78,17 @@ class FrameProgress(SolveProgress):
     """Progress of an animation, frame by frame: frames done, rate and time left, redrawn on
     a terminal, a line every :func:`log_interval` seconds in a log; ``-q`` silences it."""
 
+    def __init__(self, enabled: bool, terminal: bool | None = None) -> None:
+        super().__init__(enabled, terminal)
+        if self.terminal:  # a frame is a unit a user waits for: shown from the first one
+            self.delay = 0.0
+
     def frame(self, done: int, total: int) -> None:
         if not self.enabled:
             return
         now = time.perf_counter() - self.start
-        if done < total and (now < self.delay or now - self.last < self.every):
-            return
+        if now < self.delay or (done < total and now - self.last < self.every):
+            return  # a short run says nothing; a long one's last frame is said
         self.last, self.shown = now, True
         rate = done / max(now, 1e-9)
         text = (f"frame {done}/{total}  {rate:.2f} frames/s  "

@@ -7,6 +7,7 @@ import string
 
 from ..io.mesh.formats import extensions, suffix_of
 from ..runtime.errors import InputError, OutputError, UsageProblem
+from .preflight import check_output_path
 
 #: frames an animation may have unless raised on purpose (a typo in --fps or a keyframe time
 #: would otherwise fill the disk)
@@ -34,12 +35,9 @@ def check_pattern(pattern: str) -> str:
     if suffix(pattern) not in extensions():
         raise UsageProblem(f"-o {pattern!r}: extension must be one of "
                            f"{', '.join(extensions())}")
-    folder = os.path.dirname(os.path.abspath(a))
-    try:
-        os.makedirs(folder, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"{folder}: cannot create folder: {exc.strerror}") from None
-    return folder
+    # checked, not made: the frames' commit makes it (a run that fails first leaves none)
+    check_output_path(a, None, "-o")
+    return os.path.dirname(os.path.abspath(a))
 
 
 def _fields(pattern):
@@ -76,7 +74,9 @@ def frames_on_disk(pattern: str) -> dict[int, str]:
     head, tail = literal[0][0], "".join(text for text, _ in literal[1:])
     folder, head = os.path.split(head)
     name = re.compile(re.escape(head) + r" *(\d+)" + re.escape(tail))
-    found = {}
+    found: dict[int, str] = {}
+    if not os.path.isdir(folder or "."):  # not made yet: no frame there
+        return found
     for entry in os.listdir(folder or "."):
         match = name.fullmatch(entry)
         if match and os.path.basename(pattern.format(int(match.group(1)))) == entry:

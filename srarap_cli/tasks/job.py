@@ -203,10 +203,12 @@ def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
     if job.write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
-    mesh_bytes, lost = fmt.encode(deformed, job.ascii)
-    refuse_warnings(opts, lost)
     status = JobStatus.OK if solve.complete else JobStatus.NOT_CONVERGED
     keep = solve.complete or job.keep_unconverged
+    # a mesh that is not written is not encoded: neither its format's losses nor a full
+    # temporary folder (meshio's formats) concern a run that ends "not converged"
+    mesh_bytes, lost = fmt.encode(deformed, job.ascii) if keep else (b"", [])
+    refuse_warnings(opts, lost)
     files = _files(job, keep, mesh_bytes, deformed, source, constraints, solve)
     if key is not None:
         files.append((sidecar_path(job.output), record_bytes(

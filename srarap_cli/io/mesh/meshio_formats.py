@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...runtime.bounded import OutOfMemory, OutOfTime, run_bounded, time_bound
-from ...runtime.errors import InputError
+from ...runtime.errors import InputError, OutputError
 from ...runtime.limits import available_memory, memory_note
 from .formats import MeshFormat, Written, register_format
 from .mesh import Mesh
@@ -271,14 +271,19 @@ def _writer(name, spec):
                         f"{spec.display} keeps positions and faces; write .vtu to keep it")
         out = meshio.Mesh(mesh.vertices, cells, point_data=data)
         extension = spec.extensions[0].removesuffix(".gz")
-        with tempfile.TemporaryDirectory(prefix="srarap-meshio-") as folder:
-            path = os.path.join(folder, "mesh" + extension)
-            with _quiet():
-                meshio.write(path, out, file_format=spec.writer or name, **spec.options)
-            if spec.settle is not None:
-                spec.settle(path)
-            with open(path, "rb") as fh:
-                content = fh.read()
+        try:
+            with tempfile.TemporaryDirectory(prefix="srarap-meshio-") as folder:
+                path = os.path.join(folder, "mesh" + extension)
+                with _quiet():
+                    meshio.write(path, out, file_format=spec.writer or name, **spec.options)
+                if spec.settle is not None:
+                    spec.settle(path)
+                with open(path, "rb") as fh:
+                    content = fh.read()
+        except OSError as exc:  # meshio writes a file: a full TMPDIR said only "No space left"
+            raise OutputError(f"{tempfile.gettempdir()}: cannot write the {spec.display} file "
+                              f"meshio makes there ({exc.strerror or exc}); set TMPDIR to a "
+                              "folder with room") from None
         return (gzip.compress(content, mtime=0) if spec.gzip else content), lost
     return write
 
