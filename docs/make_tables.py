@@ -1,6 +1,8 @@
 """Every table the code generates, written where the docs show it: the README's settings table
 (from the settings table, ``srarap_cli.cli.options.markdown_table``) and format table (from
-the format registry, ``srarap_cli.io.mesh.meshio_formats.markdown_table``), the warning codes
+the format registry, ``srarap_cli.io.mesh.meshio_formats.markdown_table``), the exit codes
+(the README's and ``docs/reference/exit-codes.md``, from ``srarap_cli.runtime.exit_codes``),
+the warning codes
 (``docs/reference/warnings.md``, from ``srarap_cli.runtime.warning_codes``), and the handle
 files' JSON Schema (``docs/handles.schema.json``, ``srarap_cli.io.handles.schema``).
 
@@ -19,6 +21,7 @@ ROOT = os.path.dirname(HERE)
 README = os.path.join(ROOT, "README.md")
 SCHEMA = os.path.join(HERE, "handles.schema.json")
 WARNINGS = os.path.join(HERE, "reference", "warnings.md")
+EXIT_CODES = os.path.join(HERE, "reference", "exit-codes.md")
 
 
 def replace_table(text: str, table: str) -> str:
@@ -35,15 +38,18 @@ def generated() -> dict[str, str]:
     from srarap_cli.cli.options import markdown_table as settings_table
     from srarap_cli.io.handles.schema import schema_text
     from srarap_cli.io.mesh.meshio_formats import markdown_table as formats_table
+    from srarap_cli.runtime.exit_codes import markdown_table as exit_table
     from srarap_cli.runtime.warning_codes import markdown_table as warnings_table
 
     with open(README, encoding="utf-8") as fh:
         readme = fh.read()
-    for table in (settings_table(), formats_table()):
+    for table in (settings_table(), formats_table(), exit_table(advice=False)):
         readme = replace_table(readme, table)
     with open(WARNINGS, encoding="utf-8") as fh:
         codes = replace_table(fh.read(), warnings_table())
-    return {README: readme, SCHEMA: schema_text(), WARNINGS: codes}
+    with open(EXIT_CODES, encoding="utf-8") as fh:
+        exits = replace_table(fh.read(), exit_table(advice=True))
+    return {README: readme, SCHEMA: schema_text(), WARNINGS: codes, EXIT_CODES: exits}
 
 
 def main(argv: list[str]) -> int:
@@ -57,7 +63,8 @@ def main(argv: list[str]) -> int:
             with open(path, "w", encoding="utf-8") as fh:
                 fh.write(text)
     if stale:
-        print(("stale: " if "--check" in argv else "wrote: ") + ", ".join(stale))
+        print(("stale: " if "--check" in argv else "wrote: ") + ", ".join(stale)
+              + ("; run: python docs/make_tables.py" if "--check" in argv else ""))
     return 1 if stale and "--check" in argv else 0
 
 

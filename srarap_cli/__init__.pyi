@@ -2,16 +2,26 @@
 # (__init__.py's __getattr__), which a checker cannot follow. Keep in step with _WHERE there
 # (tests/test_api_types.py checks both name the same objects).
 from .io.handles import Constraints as Constraints
+from .io.handles import as_constraints as as_constraints
 from .io.handles import load_handles as load_handles
 from .io.mesh import Mesh as Mesh
 from .io.mesh import read_mesh as read_mesh
 from .io.mesh import write_mesh as write_mesh
+from .io.mesh.formats import MeshFormat as MeshFormat
+from .io.mesh.formats import register_format as register_format
 from .solver.deformer import Deformer as Deformer
 from .solver.interface import Solver as Solver
+from .solver.oneshot import make_deformer as make_deformer
 from .solver.result import DeformResult as DeformResult
+from .solver.result import MultiresPart as MultiresPart
 from .solver.settings import Settings as Settings
+from .solver.settings import resolve as resolve
 from .solver.stop import StopReason as StopReason
 from .tasks.api import deform as deform
+from .tasks.compare import Comparison as Comparison
+from .tasks.compare import compare_meshes as compare_meshes
+from .tasks.compare_job import CompareJob as CompareJob
+from .tasks.compare_job import run_compare as run_compare
 from .tasks.pipeline import deform_mesh as deform_mesh
 
 __version__: str

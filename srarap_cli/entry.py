@@ -18,7 +18,7 @@ _signal.pthread_sigmask(_signal.SIG_BLOCK, _HOLD)
 
 import signal  # noqa: E402 -- after the signals are held
 
-from .runtime import clock, descriptors, signals  # noqa: E402, F401 -- the clock starts here
+from .runtime import clock, descriptors, exit_codes, signals  # noqa: E402, F401 -- the clock starts here
 
 
 def main() -> None:
@@ -44,11 +44,11 @@ def _run() -> int:
     except KeyboardInterrupt:
         signals.streams.release()
         sys.stderr.write(f"srarap: error: interrupted; {_written()}\n")
-        return 130
+        return exit_codes.INTERRUPTED
     except signals.Terminated:
         signals.streams.release()
         sys.stderr.write(f"srarap: error: terminated; {_written()}\n")
-        return 143
+        return exit_codes.TERMINATED
     except Exception as exc:  # noqa: BLE001 -- past every command's own boundary: one line,
         # not the silent exit 1 that leaving without the interpreter's teardown would give
         sys.stderr.write(f"srarap: error: internal error: {type(exc).__name__}: {exc}\n")

@@ -578,3 +578,29 @@ def test_a_short_animation_in_a_log_prints_no_progress_line(tmp_path):
                         str(tmp_path / "f_{}.obj"), "--frames", "3"],
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0 and "progress" not in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("error", [RuntimeError("SuperLU malloc failed"),
+                                   OSError(12, "Cannot allocate memory"), MemoryError()])
+def test_a_memory_failure_in_the_solve_is_exit_4_from_every_command(tmp_path, monkeypatch,
+                                                                     error):
+    """Issue 62's mutation: an out-of-memory failure arriving as SuperLU's RuntimeError or
+    as ENOMEM could exit 1 unnoticed. deform, animate and a batch job each say 4."""
+    from srarap_cli.tasks import pipeline
+
+    def fail(*args, **kwargs):
+        raise error
+
+    monkeypatch.setattr(pipeline, "make_deformer", fail)
+    r = run_cli(["deform", BAR, TWIST, "-o", tmp_path / "o.obj"])
+    assert one_line(r, 4).startswith("srarap: error: out of memory")
+    r = run_cli(["animate", BAR, os.path.join(ROOT, "configs", "bar-twist-animated.yaml"),
+                 "-o", tmp_path / "f_{}.obj", "--frames", "2"])
+    assert one_line(r, 4).startswith("srarap: error: out of memory")
+    manifest = tmp_path / "jobs.yaml"
+    manifest.write_text(json.dumps({"jobs": [{"mesh": BAR, "handles": TWIST,
+                                              "output": "a.obj"}]}))
+    r = run_cli(["batch", manifest, "-o", tmp_path / "out"])
+    rows = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert r.returncode == 8 and rows[0]["exit_code"] == 4
+    assert rows[0]["message"].startswith("out of memory")

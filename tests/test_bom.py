@@ -12,11 +12,11 @@ from helpers import tube_mesh
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from srarap_cli.cli.render import _read_log
 from srarap_cli.io.documents import load_document
 from srarap_cli.io.handles import load_handles
 from srarap_cli.io.handles.formats import read_def, read_dmat, read_sel
 from srarap_cli.io.mesh import format_mesh, read_mesh
+from srarap_cli.io.solve_log import read_log
 
 BOM = b"\xef\xbb\xbf"
 MESH = tube_mesh(rings=3, segments=4)
@@ -123,4 +123,4 @@ def test_logs_for_plot(tmp_path, energies, kind):
     else:
         text = "".join(json.dumps(r) + "\n" for r in rows)
     a, b = _pair(tmp_path, "log." + kind, text.encode())
-    assert _read_log(a) == _read_log(b)
+    assert read_log(a) == read_log(b)

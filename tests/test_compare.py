@@ -51,9 +51,25 @@ def test_different_topology_uses_surface_distances():
     F = np.array([[0, 1, 2], [0, 2, 3]])
     fine_V, fine_F = igl.upsample(V, F, 2)
     same = compare_meshes(tri_mesh(V, F), tri_mesh(fine_V, fine_F))
-    assert same["mode"] == "surface" and same["max"] < 1e-12
+    assert same.mode == "surface" and same.max < 1e-12
     lifted = compare_meshes(tri_mesh(V, F), tri_mesh(fine_V + [0, 0, 0.3], fine_F))
-    assert np.isclose(lifted["max"], 0.3) and np.isclose(lifted["mean"], 0.3)
+    assert np.isclose(lifted.max, 0.3) and np.isclose(lifted.mean, 0.3)
+    # the one home of "relative to the diagonal": sqrt(2) here
+    rel = lifted.scaled(True)
+    assert np.isclose(rel.max, 0.3 / np.sqrt(2)) and rel.relative and rel.scale == np.sqrt(2)
+    assert rel.scaled(False).max == lifted.max and not rel.scaled(False).relative
+    assert rel.verdict(0.3 / np.sqrt(2) + 1e-9).within and not rel.verdict(0.2).within
+    assert rel.verdict(0.2).beyond == 1.0 and rel.verdict(0.3).beyond == 0.0
+
+
+def test_compare_runs_from_python_as_the_command_does(pair, tmp_path):
+    from srarap_cli.tasks.compare_job import CompareJob, run_compare
+    _, a, b = pair
+    done = run_compare(CompareJob(str(a), str(b), tol=1e-9, json=str(tmp_path / "r.json")))
+    assert done.exit_code == 7 and not done.verdict.within
+    assert json.loads((tmp_path / "r.json").read_text()) == done.figures()
+    r = run(a, b, "--tol", "1e-9")
+    assert done.summary() in r.stderr
 
 
 def test_missing_file_is_invalid_input(pair, tmp_path):

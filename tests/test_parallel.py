@@ -280,6 +280,8 @@ def test_a_background_stage_that_cannot_get_a_thread_runs_in_turn(monkeypatch):
     (RuntimeError("Resource temporarily unavailable"), 4),  # libigl's pthread_create
     (RuntimeError("SuperLU malloc failed"), 4),
     (OSError(12, "Cannot allocate memory"), 4),
+    (ImportError("libx.so: failed to map segment from shared object"), 4),  # ulimit -v
+    (MemoryError(), 4),
     (BlockingIOError(11, "Resource temporarily unavailable"), 6),  # a busy pipe: not memory
 ])
 def test_every_failure_to_get_memory_or_a_thread_is_exit_4(exc, code):

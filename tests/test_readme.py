@@ -90,6 +90,21 @@ def test_one_command_writes_every_generated_table_and_none_is_stale(tmp_path):
     assert stale != text and make_tables.replace_table(stale, _formats_table()) == text
 
 
+def test_every_exit_code_is_in_the_one_table_and_named_where_used():
+    """The tables are generated from ``runtime/exit_codes.py`` (issue 62); every code it
+    names is documented, and no module writes 130, 141 or 143 as a number."""
+    import re
+
+    from srarap_cli.runtime import exit_codes
+    named = {v for k, v in vars(exit_codes).items() if k.isupper() and isinstance(v, int)}
+    assert {c for codes, _, _ in exit_codes.TABLE for c in codes} == named
+    for path in Path(ROOT, "srarap_cli").rglob("*.py"):
+        if path.name == "exit_codes.py":
+            continue
+        code = re.sub(r"#.*|\"\"\"[\s\S]*?\"\"\"", "", path.read_text(encoding="utf-8"))
+        assert not re.search(r"(exit|_exit|return|: |, )\s*\(?\s*1(30|41|43)\b", code), path
+
+
 def _formats_table():
     from srarap_cli.io.mesh.meshio_formats import markdown_table
     return markdown_table()

@@ -72,3 +72,17 @@ def test_a_pattern_without_frame_0_or_with_options_it_cannot_take_is_one_line(fr
     assert r.exit_code == 2 and "frame pattern" in r.stderr
     r = render(frames, "-o", tmp_path / "x.jpg")
     assert r.exit_code == 2
+
+
+def test_render_takes_every_frame_animate_may_write(tmp_path):
+    """``animate`` writes up to 100,000 frames and ``render`` refused more than 10,000 (two
+    limits for one concept, issue 62): a sheet of 10,001 frames is drawn (24 of them read),
+    and only a GIF, which holds every frame, says how many it takes."""
+    tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+    for k in range(10_001):
+        (tmp_path / f"f_{k:05d}.obj").write_text(tri)
+    pattern = str(tmp_path / "f_{:05d}.obj")
+    r = CliRunner().invoke(main, ["render", pattern, "-o", str(tmp_path / "sheet.png")])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(main, ["render", pattern, "-o", str(tmp_path / "a.gif")])
+    assert r.exit_code == 4 and "10001 frames, more than a GIF takes (10000)" in r.output

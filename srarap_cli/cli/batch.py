@@ -17,7 +17,7 @@ from ..tasks.batch.manifest import check_outputs, load_manifest
 from ..tasks.batch.report import junit_xml, report_html
 from ..tasks.batch.rows import BatchInterrupted
 from ..tasks.batch.run import run_batch
-from ..tasks.job_status import SUMMARY_FIELDS, WARNING_JOIN, JobStatus
+from ..tasks.job_status import SUMMARY_FIELDS, WARNING_JOIN, JobStatus, batch_exit_code
 from ..tasks.preflight import check_output_path
 from .common import guarded, printable, say
 from .options import StrictCommand, setting_option
@@ -98,10 +98,9 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     if stopped is not None:
         raise SystemExit(exit_codes.TERMINATED if isinstance(stopped, Terminated)
                          else exit_codes.INTERRUPTED)
-    if any(r.status in (JobStatus.FAILED, JobStatus.REGRESSED) for r in rows):
-        raise SystemExit(exit_codes.BATCH_FAILED)
-    if any(r.status is JobStatus.NOT_CONVERGED for r in rows):
-        raise SystemExit(exit_codes.NOT_CONVERGED)
+    code = batch_exit_code(r.status for r in rows)
+    if code:
+        raise SystemExit(code)
 
 
 def _write_reports(rows, manifest, report, junit):

@@ -85,7 +85,7 @@ class LazyGroup(click.Group):
             signals.block()
             streams.release()
             click.echo("srarap: error: terminated; no output written", err=True)
-            sys.exit(143)
+            sys.exit(exit_codes.TERMINATED)
         except click.UsageError as exc:
             where = exc.ctx.command_path if exc.ctx is not None else "srarap"
             click.echo(f"srarap: error: {exc.format_message()} (see '{where} --help')", err=True)
@@ -104,7 +104,7 @@ class LazyGroup(click.Group):
             signals.block()
             streams.release()
             click.echo("srarap: error: interrupted; no output written", err=True)
-            sys.exit(130)
+            sys.exit(exit_codes.INTERRUPTED)
         sys.exit(code if isinstance(code, int) else 0)
 
     def _parse_and_invoke(self, args: Sequence[str] | None, prog_name: str | None,

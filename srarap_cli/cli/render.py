@@ -1,7 +1,4 @@
 """``srarap render`` and ``srarap plot``: pictures of meshes and of energy logs."""
-import csv
-import json
-import math
 import os
 
 import click
@@ -10,8 +7,10 @@ import numpy as np
 from ..io.handles import load_handles
 from ..io.mesh import read_mesh
 from ..io.mesh.formats import MeshFormat
+from ..io.solve_log import read_log
 from ..runtime.commit import commit_files
 from ..runtime.errors import InputError
+from ..tasks.frame_files import frame_paths
 from ..tasks.frames import animated_gif, contact_sheet, frame_pictures, sheet_choice
 from ..tasks.info import up_axis, up_decided
 from ..tasks.log_axis import decades_axis
@@ -87,8 +86,9 @@ def render(mesh: str, out: str, handles: str | None, rest: str | None, color: st
                                     size, up))])
 
 
-#: a frame pattern's frames at most (a GIF or sheet of more is a mistake, and slow)
-MAX_FRAMES = 10_000
+#: frames of an animated GIF at most (each one a picture held until the file is encoded); a
+#: contact sheet draws 24 of any number
+MAX_GIF_FRAMES = 10_000
 
 
 def _frames(pattern, out, handles, rest, color, layout, up, views, size, fps):
@@ -99,38 +99,22 @@ def _frames(pattern, out, handles, rest, color, layout, up, views, size, fps):
                                "and --fps; not --rest, --color, --layout or several views")
     _check_view(views[0])
     size = parse_size(size or "480x360")
-    paths = _frame_files(pattern)
+    paths = frame_paths(pattern)
+    gif = out.lower().endswith(".gif")
+    if gif and len(paths) > MAX_GIF_FRAMES:
+        raise InputError(f"{pattern}: {len(paths)} frames, more than a GIF takes "
+                         f"({MAX_GIF_FRAMES}); -o sheet.png draws 24 of them")
     refuse_overwrite([out], handles=handles, others=[("frame", p) for p in paths])
-    meshes = [read_mesh(p) for p in paths]
+    numbers = list(range(len(paths))) if gif else sheet_choice(len(paths))
+    meshes = [read_mesh(paths[k]) for k in numbers]  # a sheet reads only the frames it draws
     if any(len(m.vertices) != len(meshes[0].vertices) for m in meshes):
         raise InputError(f"{pattern}: the frames do not all have the same vertices")
     constraints = (load_handles(handles, meshes[0].vertices, any_rate=True) if handles
                    else None)
     up = _auto_up(meshes[0]) if up == "auto" else up
-    numbers = list(range(len(paths)))
-    if out.lower().endswith(".png"):
-        numbers = sheet_choice(len(paths))
-        meshes = [meshes[k] for k in numbers]
     pictures = frame_pictures(meshes, numbers, constraints, views[0], size, up)
-    data = animated_gif(pictures, fps) if out.lower().endswith(".gif") else \
-        contact_sheet(pictures)
+    data = animated_gif(pictures, fps) if gif else contact_sheet(pictures)
     commit_files([(out, data)])
-
-
-def _frame_files(pattern):
-    """The files of a frame pattern from frame 0 up to the first missing one."""
-    try:
-        paths: list[str] = []
-        while os.path.isfile(pattern.format(len(paths))):
-            paths.append(pattern.format(len(paths)))
-            if len(paths) > MAX_FRAMES:
-                raise InputError(f"{pattern}: more than {MAX_FRAMES} frames")
-    except (IndexError, KeyError, ValueError) as exc:
-        raise click.BadParameter(f"{pattern!r}: not a frame pattern with one field like "
-                                 f"'{{:04d}}' ({exc})", param_hint="MESH") from None
-    if not paths:
-        raise InputError(f"{pattern}: no frame 0 ({pattern.format(0)} does not exist)")
-    return paths
 
 
 def _check_view(view):
@@ -161,7 +145,7 @@ def plot(logs: tuple[str, ...], out: str, size: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    tables = [(path, _read_log(path)) for path in logs]  # every log checked before drawing
+    tables = [(path, read_log(path)) for path in logs]  # every log checked before drawing
     fig, (a, b) = plt.subplots(1, 2, figsize=(w / 100, h / 100), dpi=100)
     times, energies = [], []
     for path, rows in tables:
@@ -185,40 +169,6 @@ def plot(logs: tuple[str, ...], out: str, size: str) -> None:
     fig.savefig(buf, format="png", metadata={"Software": None})
     plt.close(fig)
     commit_files([(out, buf.getvalue())])
-
-
-def _read_log(path):
-    from ..io.input_files import open_input
-    from ..runtime.errors import InputError
-    try:
-        with open_input(path, encoding="utf-8") as fh:
-            if path.lower().endswith(".csv"):
-                rows = list(csv.DictReader(fh))
-            else:
-                rows = [json.loads(line) for line in fh if line.strip()]
-    except RecursionError:  # json nests as deep as the text does: a hostile line
-        raise InputError(f"{path}: not a readable log (a row nested too deeply)") from None
-    except (OSError, ValueError) as exc:
-        raise InputError(f"{path}: not a readable log ({exc})") from None
-    fields = ("iteration", "total", "seconds")
-    if not rows or not all(isinstance(r, dict) and set(fields) <= set(r) for r in rows):
-        raise InputError(f"{path}: not a srarap deform log (every row needs iteration, total, "
-                         "seconds)")
-    for k, row in enumerate(rows):
-        try:
-            if not all(math.isfinite(float(row[f])) for f in fields):
-                raise ValueError
-        except (TypeError, ValueError):
-            bad = next(f for f in fields if not _number(row[f]))
-            raise InputError(f"{path}: row {k + 1}: {bad} is not a number") from None
-    return rows
-
-
-def _number(value):
-    try:
-        return math.isfinite(float(value))
-    except (TypeError, ValueError):
-        return False
 
 
 def _auto_up(mesh):

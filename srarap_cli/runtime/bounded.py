@@ -71,7 +71,7 @@ def run_bounded(func: Callable[..., Any], *args: Any, seconds: float,
         return value
     if kind == "memory":
         raise OutOfMemory(value)
-    if kind == "error":
+    if kind == "error" and isinstance(value, BaseException):
         raise value
     raise OutOfMemory("the reading process ended without a result (killed for memory?)")
 
@@ -124,7 +124,8 @@ def _address_space_used() -> int:
 
 def _collect(read: int, seconds: float) -> bytes:
     """Everything the child writes, until it closes the pipe; OutOfTime past ``seconds``."""
-    chunks, end = [], time.monotonic() + seconds
+    chunks: list[bytes] = []
+    end = time.monotonic() + seconds
     while True:
         left = end - time.monotonic()
         if left <= 0:

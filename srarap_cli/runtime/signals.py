@@ -18,14 +18,14 @@ import time
 from collections.abc import Callable, Iterator
 from typing import Any, NoReturn
 
-from . import streams
+from . import exit_codes, streams
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 #: the first of SIGINT/SIGTERM this process received (0: none)
 RECEIVED = 0
 #: whether this process is the ``srarap`` command (:func:`own`), not a library's host
 OWNED = False
-CODES = {signal.SIGINT: 130, signal.SIGTERM: 143}
+CODES = {signal.SIGINT: exit_codes.INTERRUPTED, signal.SIGTERM: exit_codes.TERMINATED}
 WORDS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
 
 

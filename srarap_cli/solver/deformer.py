@@ -317,7 +317,7 @@ def unanchored(graph: Any, constrained: np.ndarray) -> tuple[np.ndarray, list[st
     lonely = np.flatnonzero((graph.degree == 0) & ~constrained)
     floating = np.flatnonzero(~anchored[label] & (graph.degree > 0))
     placed = int(np.sum((graph.degree == 0) & constrained))
-    notes = []
+    notes: list[str] = []
     if lonely.size or placed:
         notes.append(note("unreferenced-vertices",
                           f"{lonely.size + placed} unreferenced vertices (in no triangle): "
@@ -332,7 +332,7 @@ def unanchored(graph: Any, constrained: np.ndarray) -> tuple[np.ndarray, list[st
 
 def weight_warnings(graph: Any) -> list[str]:
     """Warnings about edge weights that can keep a solve from settling."""
-    out = []
+    out: list[str] = []
     if graph.degenerate:
         out.append(note("degenerate-angles", f"{graph.degenerate} triangle angles of zero-area "
                         "faces have no finite cotangent; their weights count as 0"))

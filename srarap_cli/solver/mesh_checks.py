@@ -109,7 +109,7 @@ def mesh_warnings(V: np.ndarray, F: np.ndarray) -> list[str]:
     >>> mesh_warnings(V, np.array([[0, 1, 2], [2, 0, 1]]))
     ['1 duplicate faces (same vertices as another face) [duplicate-faces]']
     """
-    out = []
+    out: list[str] = []
     collapsed = len(F) - len(solvable_faces(F))
     if collapsed:
         out.append(note("collapsed-faces", f"{collapsed} faces repeat a vertex; left out of the solve"))
@@ -158,7 +158,7 @@ def _unwelded_warnings(V, edges, counts):
 
 
 def _manifold_warnings(F, n, counts):
-    out = []
+    out: list[str] = []
     if (counts > 2).any():
         out.append(note("non-manifold", f"{int((counts > 2).sum())} non-manifold edges (more "
                         "than two faces); solved, the operators are defined there"))

@@ -9,7 +9,9 @@ from ..runtime.parallel import row_blocks
 from .group_rotations import label_sum
 from .libigl import igl
 from .linalg import fill_order
-from .settings import WEIGHT_KINDS
+
+#: the edge weights :func:`cell_graph` computes (the settings table offers these)
+WEIGHT_KINDS = ("cotan", "cotan-clamped", "uniform")
 
 # Half-cotangents are bounded: an angle under ~0.06 degrees (a needle) would otherwise give
 # a weight that swamps its neighbours and the conditioning of every solve.

@@ -21,9 +21,8 @@ from ..runtime.numbers import spelled, whole
 from ..runtime.warning_codes import parse_codes, parse_level
 from .local_step import METHODS
 from .multires.size import AUTO_RATIO, AUTO_SIZE, AUTO_THRESHOLD, parse_size
+from .operators import WEIGHT_KINDS
 
-#: Edge weights of the Laplacian and the bending term (see :func:`operators.cell_graph`).
-WEIGHT_KINDS = ("cotan", "cotan-clamped", "uniform")
 #: How the one-solve local steps get the rotors of constrained vertices (Deformer.handle_rotors).
 HANDLE_ROTORS = ("boundary", "lagged")
 #: the largest integer setting (iterations, threads): past it, numpy's integers overflow

@@ -178,7 +178,7 @@ def unreached_keys(constraints: Constraints, n_frames: int, fps: float | None,
     """A warning per keyframed group with keys after the last frame of an animation of
     ``n_frames`` frames (frames 0 .. n_frames - 1): no frame shows those poses (keys given
     in seconds at a high ``fps`` that all fall before frame 1, or ``--frames`` too few)."""
-    out = []
+    out: list[str] = []
     names = {tuple(constraints.ids[slots]): None for slots, _, _ in constraints.tracks}
     for name, ids in constraints.groups.items():
         key = tuple(np.sort(np.asarray(ids)))

@@ -1,9 +1,10 @@
 """The one-shot function of the Python API: any mesh, any handles, one deformation."""
 from collections.abc import Callable
 from dataclasses import replace
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..io.handles import as_constraints
 from ..io.mesh.mesh import Mesh
@@ -14,11 +15,28 @@ from ..solver.settings import STAGES, Settings, keywords, resolve
 from .pipeline import deform_mesh
 
 
-def deform(mesh: Any, handles: Any, *arrays: Any,
+@overload
+def deform(mesh: Any, handles: Any, /, *, callback: Callable[[dict], None] | None = None,
+           cache: str | None = None, settings: Settings | None = None,
+           **options: Any) -> DeformResult: ...
+
+
+@overload
+def deform(mesh: ArrayLike, handles: ArrayLike, constrained: ArrayLike, targets: ArrayLike, /,
+           *, callback: Callable[[dict], None] | None = None, cache: str | None = None,
+           initial: tuple[np.ndarray, np.ndarray] | None = None,
+           settings: Settings | None = None, **options: Any) -> DeformResult: ...
+
+
+def deform(mesh: Any, handles: Any, /, *arrays: Any,
            callback: Callable[[dict], None] | None = None, cache: str | None = None,
            initial: tuple[np.ndarray, np.ndarray] | None = None,
            settings: Settings | None = None, **options: Any) -> DeformResult:
     """Deform a mesh by its handles, in one call.
+
+    Two forms (typed as two overloads): ``deform(mesh, handles, **settings)`` and the array
+    form ``deform(V, F, constrained, targets, initial=None, **settings)``; the first two
+    arguments are positional in both (a setting can then never collide with their names).
 
     Parameters
     ----------

@@ -84,6 +84,27 @@ def frames_on_disk(pattern: str) -> dict[int, str]:
     return found
 
 
+def frame_paths(pattern: str) -> list[str]:
+    """The files of an animation's frame ``pattern`` (as ``animate`` writes them) from frame
+    0 up to the first missing one, found by listing their folder (not by trying names: an
+    animation may have :data:`MAX_FRAMES` and more). InputError without a frame 0,
+    UsageProblem for a pattern without one frame-number field."""
+    try:
+        first = pattern.format(0)
+        if first == pattern.format(1):
+            raise ValueError("no field for the frame number")
+    except (IndexError, KeyError, ValueError) as exc:
+        raise UsageProblem(f"{pattern!r}: not a frame pattern with one field like "
+                           f"'{{:04d}}' ({exc})") from None
+    found = frames_on_disk(pattern)
+    paths: list[str] = []
+    while len(paths) in found:
+        paths.append(found[len(paths)])
+    if not paths:
+        raise InputError(f"{pattern}: no frame 0 ({first} does not exist)")
+    return paths
+
+
 def remove_stale(pattern: str, first: int) -> int:
     """Remove the frames from ``first`` on that an earlier run left under ``pattern``;
     returns how many."""

@@ -1,6 +1,7 @@
 """How a job ended: a status, its exit code, and the figures every report of it shows (the
 batch's console table, ``summary.csv`` / ``summary.json``, the HTML report, JUnit)."""
 import enum
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -33,7 +34,27 @@ class JobStatus(enum.Enum):
 
     @property
     def passed(self) -> bool:
+        """The job did what it was asked (solved, or is up to date)."""
         return self in (JobStatus.OK, JobStatus.UP_TO_DATE)
+
+    @property
+    def unfinished(self) -> bool:
+        """The job ended without a result (a JUnit ``error``): failed or interrupted."""
+        return self in (JobStatus.FAILED, JobStatus.INTERRUPTED)
+
+    @property
+    def fails_batch(self) -> bool:
+        """The job makes its batch fail (exit 8): failed or regressed."""
+        return self in (JobStatus.FAILED, JobStatus.REGRESSED)
+
+
+def batch_exit_code(statuses: Iterable["JobStatus"]) -> int:
+    """A finished batch's exit code from its jobs' statuses: 8 when any failed or regressed,
+    else 3 when any did not converge, else 0 (a stopped batch exits with its signal's)."""
+    statuses = list(statuses)
+    if any(s.fails_batch for s in statuses):
+        return exit_codes.BATCH_FAILED
+    return exit_codes.NOT_CONVERGED if JobStatus.NOT_CONVERGED in statuses else exit_codes.OK
 
 
 _EXIT_CODES = {JobStatus.OK: exit_codes.OK, JobStatus.UP_TO_DATE: exit_codes.OK,

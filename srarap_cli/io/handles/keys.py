@@ -4,10 +4,9 @@ import numpy as np
 from ...solver.quaternion import IDENTITY, from_matrix
 from .fields import Context
 from .keyframes import EASINGS, Track
-from .transforms import rotation_matrix
+from .transforms import STATIC_ACTIONS, rotation_matrix
 
 KEY_KEYS = ("frame", "time", "translate", "rotate")
-STATIC_ACTIONS = ("fixed", "translate", "rotate", "matrix")
 
 
 def parse_track(ctx: Context, spec: dict, rest: np.ndarray, fps: float | None,

@@ -12,9 +12,9 @@ from typing import Any
 from ...runtime.warning_codes import CODES
 from ...solver.settings import MAX_INT, SETTINGS
 from .keyframes import EASINGS
-from .keys import KEY_KEYS, STATIC_ACTIONS
+from .keys import KEY_KEYS
 from .selectors import SELECTOR_KEYS
-from .transforms import ACTION_KEYS, ANGLE_KEYS, QUATERNION_KEYS
+from .transforms import ACTION_KEYS, ANGLE_KEYS, QUATERNION_KEYS, STATIC_ACTIONS
 
 NUMBER = {"type": "number"}
 VEC3 = {"type": "array", "items": NUMBER, "minItems": 3, "maxItems": 3}

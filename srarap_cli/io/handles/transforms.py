@@ -9,6 +9,9 @@ from .fields import Context
 from .formats import read_def
 
 ACTION_KEYS = ("fixed", "translate", "rotate", "pivot", "matrix")
+#: the actions that say where a group goes once (``pivot`` only says about what a rotation
+#: turns, keyframed or not): keyframes take none of them beside (the parser and the schema)
+STATIC_ACTIONS = tuple(k for k in ACTION_KEYS if k != "pivot")
 
 
 #: rotation angle keys and the factor to degrees: ``angle`` is degrees (kept for files

@@ -40,7 +40,7 @@ def coarse_mesh(V: np.ndarray, F: np.ndarray, size: int, groups: list[np.ndarray
     if cache_dir is None:
         return simplify_to_subset(V, F, size, groups), False, []
     path = os.path.join(cache_dir, cache_key(V, F, size, groups) + ".npz")
-    notes = []
+    notes: list[str] = []
     if os.path.exists(path):
         try:
             with np.load(path) as z:

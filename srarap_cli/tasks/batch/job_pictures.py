@@ -8,6 +8,7 @@ import numpy as np
 
 from ...io.handles import Constraints
 from ...io.mesh.mesh import Mesh
+from ..compare import Comparison
 from ..info import up_axis
 from ..log_axis import decades_axis
 from ..preview import UP
@@ -64,16 +65,15 @@ def energy_picture(log: Sequence[dict[str, Any]]) -> bytes:
     return buf.getvalue()
 
 
-def compare_pictures(a: Mesh, b: Mesh, figures: dict[str, Any], tol: float,
-                     scale: float) -> dict[str, str]:
+def compare_pictures(a: Mesh, b: Mesh, found: Comparison, tol: float) -> dict[str, str]:
     """``compare``'s report pictures (base64 PNG): ``shape``, B over A ghosted (when they
-    share vertices), and ``difference``, B coloured by each vertex's distance to A."""
+    share vertices), and ``difference``, B coloured by each vertex's distance to A (in
+    ``found``'s unit)."""
     from .report import encode_png
 
     out = {}
-    if figures["mode"] == "per-vertex":
+    if found.mode == "per-vertex":
         out["shape"] = encode_png(shape_picture(a, b, None))
-    d = figures["distances"]
-    d = d if figures["mode"] == "per-vertex" else d[-len(b.vertices):]
-    out["difference"] = encode_png(difference_picture(a, b, d, tol, scale))
+    out["difference"] = encode_png(difference_picture(a, b, found.of_b(len(b.vertices)), tol,
+                                                      found.scale))
     return out

@@ -151,11 +151,11 @@ def junit_xml(rows: Sequence[JobResult], suite: str) -> str:
     properties = []
     for r in rows:
         detail, inner = _detail(r), ""
-        if r.status in (JobStatus.FAILED, JobStatus.INTERRUPTED):
+        if r.status.unfinished:
             errors += 1
             inner = (f"<error type={_attr(r.status.value)} message={_attr(detail)}>"
                      f"{escape(xml_text(detail))}</error>")
-        elif r.status in (JobStatus.REGRESSED, JobStatus.NOT_CONVERGED):
+        elif not r.status.passed:
             failures += 1
             inner = (f"<failure type={_attr(r.status.value)} message={_attr(detail)}>"
                      f"{escape(xml_text(detail))}</failure>")

@@ -68,13 +68,10 @@ def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
         out_pictures["shape"] = encode_png(shape_picture(mesh, deformed, constraints))
         golden = seen.get("golden")
         if golden is not None:
-            figures, expect = golden
-            scale = figures["diagonal"] if expect["relative"] and figures["diagonal"] > 0 \
-                else 1.0
-            d = figures["distances"]
-            d = d if figures["mode"] == "per-vertex" else d[-len(deformed.vertices):]
-            out_pictures["difference"] = encode_png(
-                difference_picture(mesh, deformed, d, expect["tol"], scale))
+            found, expect = golden
+            out_pictures["difference"] = encode_png(difference_picture(
+                mesh, deformed, found.of_b(len(deformed.vertices)), expect["tol"],
+                found.scale))
         if seen.get("log"):
             out_pictures["energy"] = encode_png(energy_picture(seen["log"]))
     except Exception as exc:  # noqa: BLE001 -- the report says why, the job's result stands

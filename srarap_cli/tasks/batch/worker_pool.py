@@ -17,6 +17,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
+from ...runtime import exit_codes
 from ...runtime.signals import SIGNALS, Terminated, deferred
 from ...runtime.threads import worker_processes
 
@@ -136,7 +137,7 @@ def _dead_exitcode(processes):
         p.join(STOP_GRACE)
         if p.exitcode is not None:
             codes.append(p.exitcode)
-    dead = [c for c in codes if c not in (0, -signal.SIGTERM, 143)]
+    dead = [c for c in codes if c not in (0, -signal.SIGTERM, exit_codes.TERMINATED)]
     return dead[0] if dead else (codes[0] if codes else 0)
 
 
@@ -148,7 +149,7 @@ def _worker_signals(batch_pid=None):
     the next write into their folder. It never outlives its parent (the batch, or the fork
     server that ends with it): see :func:`_die_with`."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, lambda signum, frame: os._exit(143))
+    signal.signal(signal.SIGTERM, lambda signum, frame: os._exit(exit_codes.TERMINATED))
     signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)  # held back since the fork
     _die_with(batch_pid)
 
@@ -167,7 +168,7 @@ def _die_with(batch_pid):
     except (OSError, AttributeError):  # not Linux: the batch's own stop has to do
         pass
     if batch_pid is not None and os.getppid() != batch_pid:
-        os._exit(143)
+        os._exit(exit_codes.TERMINATED)
 
 
 def _stop(pool):
