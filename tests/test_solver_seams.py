@@ -1,11 +1,12 @@
 """The solver's seams: drivers and starts added from outside the package, one settings
 definition behind the handle file, the CLI and the Python API."""
 import json
+import os
 
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from helpers import ends, tube
+from helpers import ROOT, ends, tube
 
 from srarap_cli import Deformer, deform
 from srarap_cli.cli import main
@@ -144,3 +145,24 @@ def test_time_limit_stops_a_solve_not_converged(bent):
     assert not r.converged and 0 < r.iterations < 100000
     assert r.stop_reason is StopReason.TIME_LIMIT and not r.complete
     assert r.log[-1]["seconds"] >= 0.3
+
+
+def test_one_settings_object_carries_a_solve_from_the_command_line_to_the_solver(monkeypatch,
+                                                                                tmp_path):
+    """Issue 62: Settings was rebuilt five times per solve. The command line resolves it once;
+    every layer below passes that object on."""
+    from srarap_cli.solver import settings as settings_module
+
+    built = []
+    real = settings_module.Settings.__post_init__
+
+    def counting(self):
+        built.append(self)
+        real(self)
+
+    monkeypatch.setattr(settings_module.Settings, "__post_init__", counting)
+    r = CliRunner().invoke(main, ["deform", os.path.join(ROOT, "sample_meshes", "bar.obj"),
+                                  os.path.join(ROOT, "configs", "bar-bend.yaml"), "-o",
+                                  str(tmp_path / "o.obj"), "-q"])
+    assert r.exit_code == 0, r.output
+    assert len(built) == 1

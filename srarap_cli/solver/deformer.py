@@ -17,7 +17,7 @@ from ..runtime.parallel import using_threads
 from ..runtime.threads import single_threaded
 from ..runtime.warning_codes import note
 from . import api_checks
-from .drivers import DRIVERS, Monitor
+from .drivers import ACCEL_DRIVERS, DRIVERS, Monitor
 from .energy import bending_energy, membrane_energy
 from .global_step import PoissonSolver
 from .group_rotations import connected_groups
@@ -31,9 +31,6 @@ from .settings import Settings, with_keywords
 from .starts import STARTS, WARM_STARTS
 from .step import LocalGlobalStep
 from .stop import StopReason
-
-# the ``accel`` setting names a driver
-ACCEL_DRIVERS = {"anderson": "anderson", "none": "plain"}
 
 
 class Deformer:

@@ -19,9 +19,11 @@ from typing import Any
 from ..runtime.errors import unknown_key
 from ..runtime.numbers import spelled, whole
 from ..runtime.warning_codes import parse_codes, parse_level
+from .drivers import ACCEL_DRIVERS
 from .local_step import METHODS
 from .multires.size import AUTO_RATIO, AUTO_SIZE, AUTO_THRESHOLD, parse_size
 from .operators import WEIGHT_KINDS
+from .starts import STARTS, WARM_STARTS
 
 #: How the one-solve local steps get the rotors of constrained vertices (Deformer.handle_rotors).
 HANDLE_ROTORS = ("boundary", "lagged")
@@ -143,10 +145,11 @@ SETTINGS = (
             minimum=0, strict=True, metavar="SECONDS"),
     Setting("accel", "choice", "anderson",
             "Outer iteration: Anderson acceleration with an energy safeguard, or none (plain "
-            "local/global fixed-point iteration).", "solve", choices=("anderson", "none")),
+            "local/global fixed-point iteration).", "solve", choices=tuple(ACCEL_DRIVERS)),
     Setting("start", "choice", "harmonic",
             "First iterate: the handles' rotations spread harmonically (harmonic) or identity "
-            "rotors (laplacian editing).", "solve", choices=("harmonic", "laplacian")),
+            "rotors (laplacian editing).", "solve",
+            choices=tuple(k for k in STARTS if k not in WARM_STARTS)),
     Setting("threads", "int", None,
             "Threads for one solve; any count gives byte-identical results (batch divides "
             "the CPUs among its workers).", "solve", minimum=1, metavar="N",
@@ -281,8 +284,11 @@ def keywords(options: Mapping[str, Any], stages: tuple[str, ...],
 def with_keywords(base: Settings | None, options: Mapping[str, Any],
                   stages: tuple[str, ...], where: str) -> Settings:
     """``base`` (default: the defaults) with a Python caller's keywords over it (see
-    :func:`keywords`), as the API's functions and classes take them."""
-    return resolve(base or DEFAULT_SETTINGS, keywords(options, stages, where))
+    :func:`keywords`), as the API's functions and classes take them; ``base`` itself, not a
+    copy, where no keyword is given (one Settings carries a solve from the command line to
+    the solver: it was rebuilt, and validated, five times)."""
+    given = keywords(options, stages, where)
+    return (base or DEFAULT_SETTINGS) if not given else resolve(base or DEFAULT_SETTINGS, given)
 
 
 DEFAULT_SETTINGS = Settings(**DEFAULTS)

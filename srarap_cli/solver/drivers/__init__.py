@@ -7,6 +7,6 @@ answers whether to stop (tolerance, iteration cap, time limit). :data:`DRIVERS` 
 drivers; :func:`register` adds one.
 """
 from .monitor import Monitor
-from .registry import DRIVERS, register
+from .registry import ACCEL_DRIVERS, CORRECTED, DRIVERS, corrected_driver, register
 
-__all__ = ["DRIVERS", "Monitor", "register"]
+__all__ = ["ACCEL_DRIVERS", "CORRECTED", "DRIVERS", "Monitor", "corrected_driver", "register"]

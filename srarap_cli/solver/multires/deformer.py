@@ -18,8 +18,8 @@ from ...runtime.stages import ended as stage_ended
 from ...runtime.threads import background, single_threaded
 from ...runtime.warning_codes import note, reworded
 from .. import api_checks
-from ..deformer import ACCEL_DRIVERS, Deformer, solve_settings
-from ..drivers.anderson import anderson_iteration
+from ..deformer import Deformer, solve_settings
+from ..drivers import corrected_driver
 from ..group_rotations import connected_groups, group_rotors
 from ..mesh_checks import edge_adjacency
 from ..quaternion import IDENTITY
@@ -356,10 +356,8 @@ class MultiresDeformer:
         change leaves smooth error that needs them (184k Spot, targets scaled by 1.01: 43
         iterations, 16.6 s never corrected, 13 and 11.1 s from the first, 17 and 12.9 s after
         5)."""
-        driver = None
-        if ACCEL_DRIVERS[settings.accel] == "anderson":
-            driver = partial(anderson_iteration, correction=_Delayed(
-                partial(self.coarse_correction, targets, settings.tol), WARM_UNCORRECTED))
+        driver = corrected_driver(settings.accel, _Delayed(
+            partial(self.coarse_correction, targets, settings.tol), WARM_UNCORRECTED))
         fine = self.fine.solve(targets, initial=initial, callback=callback, settings=settings,
                                start=start, driver=driver)
         stages = {"fine_iterations": time.perf_counter() - begin}
@@ -381,11 +379,9 @@ class MultiresDeformer:
                                 self._nearest, inner)
 
     def _driver(self, targets, tol, accel):
-        """The full-resolution driver: the accelerated one with coarse-grid corrections;
-        the plain iteration stays plain."""
-        if ACCEL_DRIVERS[accel] != "anderson":
-            return None
-        return partial(anderson_iteration, correction=self.coarse_correction(targets, tol))
+        """The full-resolution driver with coarse-grid corrections where the driver takes
+        them (the accelerated one); one that does not (the plain iteration) runs as it is."""
+        return corrected_driver(accel, self.coarse_correction(targets, tol))
 
     def _fine_start(self, targets, tol, coarse, start):
         """The lower-energy of two full-resolution starts: one local/global step from the
