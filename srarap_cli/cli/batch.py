@@ -1,23 +1,18 @@
 """``srarap batch``: run a manifest of deformations, skipping what is up to date."""
-import csv
-import io
-import json
 import os
 import re
 
 import click
 
 from ..runtime import exit_codes
-from ..runtime.commit import commit_files
-from ..runtime.encoding import utf8
 from ..runtime.errors import OutputError
 from ..runtime.signals import Terminated, block
 from ..solver.settings import BY_NAME
 from ..tasks.batch.manifest import check_outputs, load_manifest
-from ..tasks.batch.report import junit_xml, report_html
 from ..tasks.batch.rows import BatchInterrupted
 from ..tasks.batch.run import run_batch
-from ..tasks.job_status import SUMMARY_FIELDS, WARNING_JOIN, JobStatus, batch_exit_code
+from ..tasks.batch.summary import SUMMARIES, write_reports, write_summaries
+from ..tasks.job_status import JobStatus, batch_exit_code
 from ..tasks.preflight import check_output_path
 from .common import guarded, printable, say
 from .options import StrictCommand, setting_option
@@ -77,7 +72,7 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         os.makedirs(out, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
-    for name in ("summary.csv", "summary.json"):  # before solving, as deform checks its -o
+    for name in SUMMARIES:  # before solving, as deform checks its -o
         check_output_path(os.path.join(out, name), None, "summary")
     try:
         rows, stopped = run_batch(jobs, out, workers, scheduler, keep_unconverged,
@@ -87,32 +82,17 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         # the summary is what is left to do: a second Ctrl-C or SIGTERM (a CI runner's
         # timeout sends more than one) must not cost it; the exit code says stopped anyway
         block()
-    summary_rows = [r.row() for r in rows]
     # the summary first, on its own: a report that cannot be written (a full disk) must not
     # cost the account of the jobs whose outputs are on disk
-    commit_files([(os.path.join(out, "summary.csv"), utf8(_csv(summary_rows))),
-                  (os.path.join(out, "summary.json"),
-                   utf8(json.dumps(summary_rows, indent=2) + "\n"))], inside=out)
+    write_summaries(rows, out)
     _tell(rows, out, quiet, stopped)
-    _write_reports(rows, manifest, report, junit)
+    write_reports(rows, manifest, report, junit)
     if stopped is not None:
         raise SystemExit(exit_codes.TERMINATED if isinstance(stopped, Terminated)
                          else exit_codes.INTERRUPTED)
     code = batch_exit_code(r.status for r in rows)
     if code:
         raise SystemExit(code)
-
-
-def _write_reports(rows, manifest, report, junit):
-    """The HTML report and the JUnit file, committed together."""
-    title = os.path.splitext(os.path.basename(manifest))[0]
-    files = []
-    if report is not None:
-        pictures = {r.job: r.pictures for r in rows}
-        files.append((report, utf8(report_html(rows, pictures, f"srarap batch: {title}"))))
-    if junit is not None:
-        files.append((junit, utf8(junit_xml(rows, title))))
-    commit_files(files)
 
 
 def _tell(rows, out, quiet, stopped):
@@ -137,18 +117,3 @@ def _tell(rows, out, quiet, stopped):
         note = (f"; {word}: the jobs not finished are marked interrupted in "
                 f"{os.path.join(out, 'summary.csv')}")
     say(f"srarap batch: {len(rows)} jobs: {summary}{note}")
-
-
-def _csv(rows):
-    """summary.csv: one line a job. A row with a lone carriage return in a field (a job's
-    name or message) has every field quoted: the writer quotes only what holds its line
-    terminator, and every CSV reader took the bare ``\r`` for the end of a row."""
-    buf = io.StringIO()
-    plain = csv.DictWriter(buf, fieldnames=SUMMARY_FIELDS, lineterminator="\n")
-    quoted = csv.DictWriter(buf, fieldnames=SUMMARY_FIELDS, lineterminator="\n",
-                            quoting=csv.QUOTE_ALL)
-    plain.writeheader()
-    for r in rows:
-        row = {**r, "warnings": WARNING_JOIN.join(r["warnings"])}
-        (quoted if any("\r" in str(v) for v in row.values()) else plain).writerow(row)
-    return buf.getvalue()
