@@ -161,3 +161,24 @@ def test_package_files_only_re_export():
                   or (isinstance(node, ast.FunctionDef) and node.name in ("__getattr__",
                                                                           "__dir__")))
             assert ok, f"{module}: line {node.lineno} is not a re-export"
+
+
+#: what the command line may take from the lower layers besides tasks/ and runtime/: the
+#: format table (its Click type) and the settings table (options, their value types)
+CLI_MAY_IMPORT = {"srarap_cli.io.mesh", "srarap_cli.io.mesh.formats", "srarap_cli.solver.settings",
+                  "srarap_cli.solver.multires.size"}
+
+
+def test_the_cli_is_options_and_a_call_into_tasks():
+    """Issue 62: each command's work lives in tasks/ (callable from Python); cli/ turns options
+    into a job, calls it and says its summary. From io/ and solver/ it imports only the
+    format and settings tables its option types are made of."""
+    found = {}
+    for module, path in MODULES.items():
+        if not module.startswith("srarap_cli.cli"):
+            continue
+        lower = {m for m in _imports(module, path)
+                 if m.split(".")[1] in ("io", "solver") and m not in CLI_MAY_IMPORT}
+        if lower:
+            found[module] = sorted(lower)
+    assert not found, found

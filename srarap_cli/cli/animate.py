@@ -3,9 +3,7 @@ from typing import Any
 
 import click
 
-from ..runtime import exit_codes
 from ..runtime.stages import heard_by
-from ..solver.stop import StopReason
 from ..tasks.animate_job import AnimateJob, run_animation
 from ..tasks.frame_files import MAX_FRAMES
 from .common import EarlyWarnings, FiniteFloat, cache_option, guarded, report, with_verbosity
@@ -63,29 +61,6 @@ def animate(mesh: str, handles: str, pattern: str, frames: int | None, fps: floa
         progress.close()
     report(verbosity, warnings=early.rest(done.warnings),
            details=done.last.report_lines() if done.last else [],
-           summary=_summary(done, pattern, iters_per_frame))
-    if done.unconverged and iters_per_frame is None:
-        raise SystemExit(exit_codes.NOT_CONVERGED)
-
-
-def _summary(done, pattern, budget):
-    rows, first, stopped, result = done.rows, done.first, done.stopped, done.last
-    last = done.n_frames - 1 if stopped is None else stopped - 1
-    wrote = (f"wrote {pattern.format(first)} .. {pattern.format(last)}" if first <= last
-             else "nothing left to write" if stopped is None else "no frame written")
-    if first:
-        wrote += f" (frames 0-{first - 1} were kept from the interrupted run)"
-    converged = sum(r["converged"] for r in rows)
-    seconds = sum(r["seconds"] for r in rows)
-    its = sorted(r["iterations"] for r in rows)
-    head = (f"srarap animate: {converged} of {len(rows)} frames converged"
-            + (f" (fixed budget of {budget} iterations a frame)" if budget else "")
-            + (f", median {its[len(its) // 2]} iterations" if its else "")
-            + f"; {len(rows) / max(seconds, 1e-9):.2f} frames/s; {wrote}")
-    if stopped is not None:
-        reason = result.stop_reason
-        limit = "--time-limit" if reason is StopReason.TIME_LIMIT else "--max-iter"
-        head += (f"; STOPPED at frame {stopped}: not converged in {result.iterations} "
-                 f"iterations ({reason}: {result.stop_detail}; raise {limit}, or "
-                 "--keep-unconverged writes it and goes on)")
-    return head
+           summary=done.summary(pattern, iters_per_frame))
+    if done.exit_code(iters_per_frame):
+        raise SystemExit(done.exit_code(iters_per_frame))

@@ -13,12 +13,10 @@ import numpy as np
 
 from ..io.mesh import FORMATS, MeshFormat
 from ..runtime import descriptors, exit_codes, signals, streams
-from ..runtime.clock import elapsed
 from ..runtime.commit import COMMITTED
 from ..runtime.errors import OutputError
 from ..runtime.failures import classify
 from ..runtime.signals import Terminated
-from ..solver.result import DeformResult
 
 
 def fail(code: int, message: str) -> NoReturn:
@@ -123,12 +121,6 @@ def written() -> str:
     if len(files) < len(set(COMMITTED)):
         text += "; run it again with --resume to continue"
     return text
-
-
-def wall_seconds(result: DeformResult) -> float:
-    """The process's wall seconds for a summary (the solve's own when srarap runs inside
-    another program, whose clock did not start with srarap)."""
-    return elapsed() if signals.OWNED else result.seconds
 
 
 verbosity_options = [

@@ -1,5 +1,4 @@
 """``srarap deform``: mesh + handle file -> deformed mesh + energy log."""
-import math
 from typing import Any
 
 import click
@@ -7,8 +6,7 @@ import click
 from ..io.mesh.formats import MeshFormat
 from ..runtime import exit_codes, memory
 from ..runtime.stages import heard_by
-from ..solver.multires.size import AUTO_THRESHOLD
-from ..solver.stop import StopReason
+from ..tasks.deform_summary import cache_hint, summary_line
 from ..tasks.job import DeformJob, JobStatus, run_job
 from .common import (
     EarlyWarnings,
@@ -18,7 +16,6 @@ from .common import (
     input_format_option,
     pose_options,
     report,
-    wall_seconds,
     with_verbosity,
     write_stdout,
 )
@@ -79,67 +76,9 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
         progress.close()
     measured = memory.gigabytes(done.peaks)
     report(verbosity, warnings=early.rest(done.warnings),
-           details=done.solve.report_lines() + _cache_hint(done.solve, cache)
+           details=done.solve.report_lines() + cache_hint(done.solve, cache)
            + ([f"srarap: peak memory: {measured}"] if measured else []),
-           summary=_summary(done.solve, done.settings,
+           summary=summary_line(done.solve, done.settings,
                             done.written and ("<stdout>" if out == "-" else out)))
     if done.status is JobStatus.NOT_CONVERGED:
         raise SystemExit(exit_codes.NOT_CONVERGED)
-
-
-#: seconds of simplification from which ``-v`` says that ``--cache`` would skip it
-SLOW_SIMPLIFY = 10.0
-
-
-def _cache_hint(result, cache):
-    """The ``-v`` line that points a user of a large mesh at ``--cache`` (the simplification
-    is the longest stage that runs on one core)."""
-    part = result.multires
-    seconds = part.stages.get("simplify", 0.0) if part is not None else 0.0
-    if cache is not None or part is None or part.cache_hit or seconds < SLOW_SIMPLIFY:
-        return []
-    return [f"srarap: multires: the simplification took {seconds:.1f} s; --cache DIR keeps "
-            "the coarse mesh, and a rerun of this mesh skips it"]
-
-
-def _summary(result, opts, out):
-    """The one summary line: why the solve stopped (at full resolution), the
-    full-resolution and coarse iterations apart, the energy, the process's wall seconds."""
-    coarse = f" (+ {result.coarse_iterations} coarse)" if result.coarse_iterations else ""
-    e = result.energies()
-    energy = (f"energy {e['total']:.6g} (membrane {e['membrane']:.6g}, bending "
-              f"{e['bending']:.6g})")
-    reason = result.stop_reason
-    if result.approximate:
-        part = result.multires
-        state = (f"approximate (multires transfer: coarse solve "
-                 f"{'converged' if part.converged else 'NOT converged'} in "
-                 f"{part.iterations} iterations, none at full resolution)")
-        energy = f"full-resolution {energy}, {part.start_energy['total']:.6g} at the start"
-    elif reason is StopReason.CONVERGED:
-        state = f"converged in {result.iterations} full-resolution iterations{coarse}"
-    elif reason is StopReason.ITERATIONS_RUN:
-        state = f"ran the {result.iterations} iterations asked (tol 0){coarse}"
-    else:
-        state = (f"NOT converged after {result.iterations} full-resolution iterations{coarse} "
-                 f"({reason}: {result.stop_detail}; {_advice(result, opts)})")
-    return (f"srarap deform: {state}; {energy}; {wall_seconds(result):.2f} s; "
-            + (f"wrote {out}" if out else "no mesh written (--keep-unconverged writes it)"))
-
-
-def _advice(result, opts):
-    """What to try after a run that stopped unconverged, from why it stopped."""
-    if result.stop_reason is StopReason.TIME_LIMIT:
-        return f"stopped by --time-limit {opts.time_limit:g}: allow more time"
-    tips = [f"raise --max-iter (was {opts.max_iter})"]
-    n = len(result.positions)
-    if opts.multires == "off" and n >= AUTO_THRESHOLD:
-        tips.append(f"--multires auto (a coarse solve starts the {n} vertices closer)")
-    if opts.accel == "none":
-        tips.append("use --accel anderson")
-    if opts.start == "laplacian":
-        tips.append("--start harmonic")
-    last = result.log[-1]["rel_change"]
-    if not math.isnan(last):
-        tips.append(f"or loosen --tol (the last change was {last:.2g})")
-    return "try: " + ", ".join(tips)

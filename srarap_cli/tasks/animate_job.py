@@ -13,6 +13,7 @@ from typing import Any
 from ..io.handles import load_handles, referenced_files
 from ..io.mesh import format_mesh, frame_formatter
 from ..io.solve_log import LOG_FORMATS, format_log
+from ..runtime import exit_codes
 from ..runtime.commit import commit_files
 from ..runtime.encoding import utf8
 from ..runtime.errors import InputError
@@ -20,6 +21,7 @@ from ..runtime.limits import check_solve
 from ..runtime.warning_codes import note
 from ..solver.result import DeformResult
 from ..solver.settings import resolve
+from ..solver.stop import StopReason
 from .animation import FRAME_FIELDS, Animator, FrameState, fingerprint, unreached_keys
 from .frame_files import MAX_FRAMES, check_pattern, frame_count, frames_on_disk, remove_stale, suffix
 from .preflight import check_output_path, read_any_mesh, refuse_overwrite
@@ -85,6 +87,35 @@ class AnimationOutcome:
     @property
     def unconverged(self) -> int:
         return sum(not r["converged"] for r in self.rows)
+
+    def exit_code(self, budget: int | None) -> int:
+        """3 when a frame did not converge, unless every frame had a fixed ``budget`` of
+        iterations (``--iters-per-frame``); else 0."""
+        return exit_codes.NOT_CONVERGED if self.unconverged and budget is None else exit_codes.OK
+
+    def summary(self, pattern: str, budget: int | None) -> str:
+        """``srarap animate``'s one summary line: frames converged, the median iterations,
+        the rate, what was written, and where and why the sequence stopped."""
+        rows, first, stopped, result = self.rows, self.first, self.stopped, self.last
+        last = self.n_frames - 1 if stopped is None else stopped - 1
+        wrote = (f"wrote {pattern.format(first)} .. {pattern.format(last)}" if first <= last
+                 else "nothing left to write" if stopped is None else "no frame written")
+        if first:
+            wrote += f" (frames 0-{first - 1} were kept from the interrupted run)"
+        converged = sum(r["converged"] for r in rows)
+        seconds = sum(r["seconds"] for r in rows)
+        its = sorted(r["iterations"] for r in rows)
+        head = (f"srarap animate: {converged} of {len(rows)} frames converged"
+                + (f" (fixed budget of {budget} iterations a frame)" if budget else "")
+                + (f", median {its[len(its) // 2]} iterations" if its else "")
+                + f"; {len(rows) / max(seconds, 1e-9):.2f} frames/s; {wrote}")
+        if stopped is not None and result is not None:
+            reason = result.stop_reason
+            limit = "--time-limit" if reason is StopReason.TIME_LIMIT else "--max-iter"
+            head += (f"; STOPPED at frame {stopped}: not converged in {result.iterations} "
+                     f"iterations ({reason}: {result.stop_detail}; raise {limit}, or "
+                     "--keep-unconverged writes it and goes on)")
+        return head
 
 
 def run_animation(job: AnimateJob, on_frame: Callable[[int, int], None] | None = None,
