@@ -258,7 +258,7 @@ def _run(name, galerkin):
     """One default solve of a benchmark case (those of ``multires_error_split.py``)."""
     import time
 
-    from multires_error_split import _case
+    from error_split_cases import case as _case
 
     from srarap_cli.io.handles import load_handles
     from srarap_cli.io.mesh import read_mesh

@@ -39,9 +39,8 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from multires_large import CASES as LARGE  # noqa: E402
-from multires_large import _mesh  # noqa: E402
-from run_bench import OUT, ROOT  # noqa: E402
+from error_split_cases import case as _case  # noqa: E402
+from run_bench import OUT  # noqa: E402
 
 from srarap_cli.io.handles import load_handles  # noqa: E402
 from srarap_cli.io.mesh import read_mesh  # noqa: E402
@@ -50,16 +49,6 @@ from srarap_cli.solver.oneshot import make_deformer  # noqa: E402
 from srarap_cli.solver.quaternion import align_hemisphere  # noqa: E402
 from srarap_cli.solver.settings import resolve  # noqa: E402
 from srarap_cli.tasks.pipeline import problem  # noqa: E402
-
-NOD = os.path.join(ROOT, "configs", "spot-nod.yaml")
-CASES = {"spot46k": (os.path.join(OUT, "spot-46k.obj"), NOD),
-         "spot184k": (os.path.join(OUT, "spot-184k.obj"), NOD)}
-
-
-def _case(name):
-    if name in LARGE:
-        return _mesh(name)
-    return CASES[name]
 
 
 class Recorder:
