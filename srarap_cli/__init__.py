@@ -14,16 +14,16 @@ do not load the numerical stack.
 """
 import importlib
 
-_WHERE = {"Comparison": "tasks.compare", "CompareJob": "tasks.compare_job",
+_WHERE = {"Comparison": "tasks.comparison", "CompareJob": "tasks.comparison",
           "Constraints": "io.handles", "DeformResult": "solver.result",
           "Deformer": "solver.deformer", "Mesh": "io.mesh", "MeshFormat": "io.mesh.formats",
           "MultiresPart": "solver.result", "Settings": "solver.settings",
           "Solver": "solver.interface", "StopReason": "solver.stop",
-          "as_constraints": "io.handles", "compare_meshes": "tasks.compare",
+          "as_constraints": "io.handles", "compare_meshes": "tasks.comparison",
           "deform": "tasks.api", "deform_mesh": "tasks.pipeline", "load_handles": "io.handles",
           "make_deformer": "solver.oneshot", "read_mesh": "io.mesh",
           "register_format": "io.mesh.formats", "resolve": "solver.settings",
-          "run_compare": "tasks.compare_job", "write_mesh": "io.mesh"}
+          "run_compare": "tasks.comparison", "write_mesh": "io.mesh"}
 
 __all__ = sorted(_WHERE)
 

@@ -18,10 +18,10 @@ from .solver.settings import Settings as Settings
 from .solver.settings import resolve as resolve
 from .solver.stop import StopReason as StopReason
 from .tasks.api import deform as deform
-from .tasks.compare import Comparison as Comparison
-from .tasks.compare import compare_meshes as compare_meshes
-from .tasks.compare_job import CompareJob as CompareJob
-from .tasks.compare_job import run_compare as run_compare
+from .tasks.comparison import CompareJob as CompareJob
+from .tasks.comparison import Comparison as Comparison
+from .tasks.comparison import compare_meshes as compare_meshes
+from .tasks.comparison import run_compare as run_compare
 from .tasks.pipeline import deform_mesh as deform_mesh
 
 __version__: str

@@ -20,7 +20,7 @@ from srarap_cli.io.mesh import read_mesh
 from srarap_cli.runtime.errors import InputError
 from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 from srarap_cli.solver.settings import resolve
-from srarap_cli.tasks.animation import Animator
+from srarap_cli.tasks.animate.sequence import Animator
 
 BASE = {"box": {"min": [-2, -2, -0.01], "max": [2, 2, 0.01]}, "fixed": True}
 TOP_BOX = {"min": [-2, -2, 5.99], "max": [2, 2, 6.01]}

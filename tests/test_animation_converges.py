@@ -15,7 +15,7 @@ from helpers import ends, tube, tube_mesh
 from srarap_cli import Deformer
 from srarap_cli.io.mesh import write_mesh
 from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
-from srarap_cli.tasks.animation import _carried
+from srarap_cli.tasks.animate.sequence import _carried
 
 TWIST = ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
          "  top:\n    box: {min: [-2, -2, 9.99], max: [2, 2, 10.01]}\n    keyframes:\n"

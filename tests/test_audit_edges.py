@@ -429,8 +429,8 @@ def test_a_record_with_fields_srarap_never_writes_is_no_record(tmp_path, change)
 
 
 def test_the_report_escapes_every_field_of_a_row():
-    from srarap_cli.tasks.batch.report import report_html
     from srarap_cli.tasks.job_status import JobResult, JobStatus
+    from srarap_cli.tasks.reports import report_html
 
     row = JobResult("j<b>", JobStatus.OK, 0, stop="<script>x</script>", message="<i>m</i>",
                     warnings=["<w>"])

@@ -24,9 +24,9 @@ from srarap_cli.runtime.errors import (
     OutputError,
     SingularSystemError,
 )
-from srarap_cli.tasks import job
 from srarap_cli.tasks.batch import run as batch
 from srarap_cli.tasks.batch.rows import interrupted_row
+from srarap_cli.tasks.deform import job
 from srarap_cli.tasks.job_status import JobStatus
 
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
@@ -431,7 +431,7 @@ def test_a_signal_as_a_local_dask_cluster_starts_leaves_nothing_running(tmp_path
 
 def test_a_job_regresses_on_its_farthest_vertex_not_its_mean(tmp_path):
     """One vertex 0.1 away and the rest exact: the mean is far below tol, the job regressed."""
-    from srarap_cli.tasks.golden import check_golden
+    from srarap_cli.tasks.deform.golden import check_golden
     from srarap_cli.tasks.job_status import JobResult
 
     bar = read_mesh(BAR)

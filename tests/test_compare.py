@@ -10,7 +10,7 @@ from helpers import tube_mesh
 from srarap_cli.cli import main
 from srarap_cli.io.mesh import write_mesh
 from srarap_cli.io.mesh.mesh import Mesh
-from srarap_cli.tasks.compare import compare_meshes
+from srarap_cli.tasks.comparison.compare import compare_meshes
 
 
 def tri_mesh(V, F):
@@ -63,7 +63,7 @@ def test_different_topology_uses_surface_distances():
 
 
 def test_compare_runs_from_python_as_the_command_does(pair, tmp_path):
-    from srarap_cli.tasks.compare_job import CompareJob, run_compare
+    from srarap_cli.tasks.comparison.job import CompareJob, run_compare
     _, a, b = pair
     done = run_compare(CompareJob(str(a), str(b), tol=1e-9, json=str(tmp_path / "r.json")))
     assert done.exit_code == 7 and not done.verdict.within

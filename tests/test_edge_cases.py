@@ -35,7 +35,7 @@ def test_an_animation_that_stops_removes_the_later_frames_of_an_earlier_run(tmp_
 
 def test_a_hundred_million_frames_are_never_enumerated(tmp_path, monkeypatch):
     """The folder is listed, the frames' names never made one by one: counted."""
-    from srarap_cli.tasks import animate_job
+    from srarap_cli.tasks.animate import job as animate_job
 
     named = []
     real = animate_job.frames_on_disk

@@ -182,3 +182,38 @@ def test_the_cli_is_options_and_a_call_into_tasks():
         if lower:
             found[module] = sorted(lower)
     assert not found, found
+
+
+#: the kinds of work of tasks/, each a package with one entry (issue 62)
+WINGS = ("deform", "animate", "comparison", "pictures", "bench", "batch")
+
+
+def _wing(module):
+    parts = module.split(".")
+    return parts[2] if len(parts) > 2 and parts[1] == "tasks" and parts[2] in WINGS else None
+
+
+def test_a_wing_reaches_another_only_through_its_package():
+    """tasks/ is in wings; code outside a wing (another wing, the command line, the shared
+    modules) takes a wing's names from its package, never from a module inside it."""
+    found = []
+    for module, path in MODULES.items():
+        for target in _imports(module, path):
+            wing = _wing(target)
+            if wing and _wing(module) != wing and target != f"srarap_cli.tasks.{wing}":
+                found.append(f"{module} -> {target}")
+    assert not found, found
+
+
+@pytest.mark.parametrize("wing", WINGS)
+def test_each_wing_types_what_it_exports(wing):
+    """A wing's package loads its names lazily (no import cycle between wings, and no cost
+    for a command that does not use them); its ``__init__.pyi`` gives a checker every one."""
+    import importlib
+
+    package = importlib.import_module(f"srarap_cli.tasks.{wing}")
+    stub = open(os.path.join(PACKAGE, "tasks", wing, "__init__.pyi"), encoding="utf-8").read()
+    for name, where in package._WHERE.items():
+        assert f"from .{where} import {name} as {name}" in stub, name
+        assert getattr(package, name) is getattr(
+            importlib.import_module(f"srarap_cli.tasks.{wing}.{where}"), name)

@@ -2,7 +2,7 @@
 import matplotlib.pyplot as plt
 import pytest
 
-from srarap_cli.tasks.log_axis import decades_axis
+from srarap_cli.tasks.pictures.log_axis import decades_axis
 
 plt.switch_backend("Agg")
 

@@ -207,7 +207,7 @@ def test_cli_multires_runs_caches_and_gives_identical_files(tmp_path):
 
 
 def test_a_long_simplification_points_at_the_cache_unless_it_is_used(tmp_path, monkeypatch):
-    from srarap_cli.tasks import deform_summary
+    from srarap_cli.tasks.deform import advice as deform_summary
 
     monkeypatch.setattr(deform_summary, "SLOW_SIMPLIFY", 0.0)  # every simplification is long here
     args = ["deform", SPOT, NOD, "--multires", "1000", "--max-iter", "2", "--keep-unconverged",

@@ -119,7 +119,7 @@ def test_a_folder_placed_at_a_target_after_the_check_leaves_every_output_as_it_w
         os.mkdir(folder / "o.csv")  # the log's target became a folder after the check
         return real(files, **kwargs)
 
-    monkeypatch.setattr("srarap_cli.tasks.job.commit_files", swap_then_commit)
+    monkeypatch.setattr("srarap_cli.tasks.deform.job.commit_files", swap_then_commit)
     monkeypatch.chdir(folder)
     r = CliRunner().invoke(main, ["deform", "m.obj", "h.yaml", "-o", "o.obj", "--log", "o.csv",
                                   "--preview", "o.png"])

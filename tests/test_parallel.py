@@ -16,7 +16,7 @@ from srarap_cli.solver import linalg, one_triangle, operators
 from srarap_cli.solver.oneshot import make_deformer
 from srarap_cli.solver.operators import cell_graph
 from srarap_cli.tasks.batch.run import job_threads
-from srarap_cli.tasks.job_record import fingerprint
+from srarap_cli.tasks.deform.record import fingerprint
 
 
 def _cgroup(tmp_path, membership, files):

@@ -13,7 +13,7 @@ from srarap_cli.cli import main
 from srarap_cli.io.mesh import write_mesh
 from srarap_cli.solver.quaternion import from_axis_angle, to_matrix
 from srarap_cli.tasks.distortion import vertex_distortion
-from srarap_cli.tasks.render import PALETTE
+from srarap_cli.tasks.pictures.render import PALETTE
 
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
 BEND = os.path.join(ROOT, "configs", "bar-bend.yaml")
@@ -164,7 +164,7 @@ def _dense_tube(rings=200, segments=100):
 
 
 def test_a_mesh_larger_than_its_pixels_is_drawn_reduced_with_its_colours():
-    from srarap_cli.tasks.render import display_mesh
+    from srarap_cli.tasks.pictures.render import display_mesh
 
     V, F = _dense_tube()
     top = V[F].mean(axis=1)[:, 2] > 3.0
@@ -186,7 +186,7 @@ def test_a_mesh_larger_than_its_pixels_is_drawn_reduced_with_its_colours():
 def test_the_reduced_picture_looks_like_the_full_one(tmp_path, monkeypatch):
     """What the eye compares: the same silhouette and shading, pixel by pixel, with and
     without the reduction; and matplotlib gets no more faces than the pixels can show."""
-    from srarap_cli.tasks import render
+    from srarap_cli.tasks.pictures import render
 
     V, F = _dense_tube(rings=240, segments=120)
     colors = render.face_colors(F, [np.flatnonzero(V[:, 2] < 0.5)])

@@ -9,8 +9,8 @@ from helpers import ROOT
 from PIL import Image
 
 from srarap_cli.cli import main
-from srarap_cli.tasks.frames import sheet_choice
-from srarap_cli.tasks.render import PALETTE
+from srarap_cli.tasks.pictures.frames import sheet_choice
+from srarap_cli.tasks.pictures.render import PALETTE
 
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
 TWIST = os.path.join(ROOT, "configs", "bar-twist-animated.yaml")

@@ -15,8 +15,8 @@ from click.testing import CliRunner
 from helpers import ROOT
 
 from srarap_cli.cli import main
-from srarap_cli.tasks.batch.report import junit_xml, report_html
 from srarap_cli.tasks.job_status import JobResult, JobStatus
+from srarap_cli.tasks.reports import junit_xml, report_html
 
 BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
 CONFIGS = os.path.join(ROOT, "configs")

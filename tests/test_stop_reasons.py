@@ -17,8 +17,8 @@ from srarap_cli.solver.interface import Solver
 from srarap_cli.solver.multires import MultiresDeformer
 from srarap_cli.solver.oneshot import make_deformer
 from srarap_cli.solver.stop import StopReason
-from srarap_cli.tasks import job as job_runner
 from srarap_cli.tasks.batch import run as batch
+from srarap_cli.tasks.deform import job as job_runner
 
 
 @pytest.fixture(scope="module")

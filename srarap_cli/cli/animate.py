@@ -4,8 +4,7 @@ from typing import Any
 import click
 
 from ..runtime.stages import heard_by
-from ..tasks.animate_job import AnimateJob, run_animation
-from ..tasks.frame_files import MAX_FRAMES
+from ..tasks.animate import MAX_FRAMES, AnimateJob, run_animation
 from .common import EarlyWarnings, FiniteFloat, cache_option, guarded, report, with_verbosity
 from .options import StrictCommand, settings_options
 from .progress import FrameProgress

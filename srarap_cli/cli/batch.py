@@ -8,10 +8,15 @@ from ..runtime import exit_codes
 from ..runtime.errors import OutputError
 from ..runtime.signals import Terminated, block
 from ..solver.settings import BY_NAME
-from ..tasks.batch.manifest import check_outputs, load_manifest
-from ..tasks.batch.rows import BatchInterrupted
-from ..tasks.batch.run import run_batch
-from ..tasks.batch.summary import SUMMARIES, write_reports, write_summaries
+from ..tasks.batch import (
+    SUMMARIES,
+    BatchInterrupted,
+    check_outputs,
+    load_manifest,
+    run_batch,
+    write_reports,
+    write_summaries,
+)
 from ..tasks.job_status import JobStatus, batch_exit_code
 from ..tasks.preflight import check_output_path
 from .common import guarded, printable, say

@@ -4,7 +4,7 @@ from typing import Any
 import click
 
 from ..runtime.encoding import utf8
-from ..tasks.bench_job import CHOICES, OWN_DEFAULTS, BenchJob, run_bench
+from ..tasks.bench import CHOICES, OWN_DEFAULTS, BenchJob, run_bench
 from .common import FiniteFloat, guarded, write_stdout
 from .options import settings_options
 

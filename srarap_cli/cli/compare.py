@@ -2,7 +2,7 @@
 import click
 
 from ..io.mesh.formats import MeshFormat
-from ..tasks.compare_job import CompareJob, run_compare
+from ..tasks.comparison import CompareJob, run_compare
 from .common import FiniteFloat, guarded, input_format_option, say
 
 

@@ -6,8 +6,7 @@ import click
 from ..io.mesh.formats import MeshFormat
 from ..runtime import exit_codes, memory
 from ..runtime.stages import heard_by
-from ..tasks.deform_summary import cache_hint, summary_line
-from ..tasks.job import DeformJob, JobStatus, run_job
+from ..tasks.deform import DeformJob, JobStatus, cache_hint, run_job, summary_line
 from .common import (
     EarlyWarnings,
     MeshFormatType,

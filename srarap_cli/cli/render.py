@@ -2,8 +2,7 @@
 import click
 
 from ..io.mesh.formats import MeshFormat
-from ..tasks.picture_jobs import PlotJob, RenderJob, run_plot, run_render
-from ..tasks.render import VIEWS
+from ..tasks.pictures import VIEWS, PlotJob, RenderJob, run_plot, run_render
 from .common import FiniteFloat, guarded, input_format_option, say
 
 

@@ -5,8 +5,7 @@ from typing import Any
 
 from ...runtime import exit_codes
 from ...runtime.signals import Terminated
-from ..job import DeformJob, JobResult, JobStatus, recorded_result
-from ..job_record import sidecar_path
+from ..deform import DeformJob, JobResult, JobStatus, recorded_result, sidecar_path
 from .worker_pool import death_note
 
 #: a job of a manifest: name, absolute paths, output, settings, expect

@@ -24,10 +24,10 @@ from ...io.handles import load_handles
 from ...io.mesh import read_mesh
 from ...runtime.parallel import ENV, at_most, available_cpus, default_threads, using_threads
 from ...runtime.signals import Terminated
-from ..job import JobResult, run_job_safely
-from .job_pictures import difference_picture, energy_picture, shape_picture
+from ..deform import JobResult, run_job_safely
+from ..pictures import difference_picture, energy_picture, shape_picture
+from ..reports import encode_png
 from .on_dask import run_on_dask
-from .report import encode_png
 from .rows import BatchInterrupted, Job, deform_job, interrupted_row, lost_row, solved_since
 from .worker_pool import PoolStopped, run_in_processes
 

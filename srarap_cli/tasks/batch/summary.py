@@ -8,8 +8,8 @@ import os
 from ...runtime.commit import commit_files
 from ...runtime.encoding import utf8
 from ..job_status import SUMMARY_FIELDS, WARNING_JOIN, JobResult
+from ..reports import junit_xml, report_html
 from .manifest import SUMMARIES
-from .report import junit_xml, report_html
 
 
 def write_summaries(rows: list[JobResult], out: str) -> None:

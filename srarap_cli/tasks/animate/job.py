@@ -10,21 +10,21 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..io.handles import load_handles, referenced_files
-from ..io.mesh import format_mesh, frame_formatter
-from ..io.solve_log import LOG_FORMATS, format_log
-from ..runtime import exit_codes
-from ..runtime.commit import commit_files
-from ..runtime.encoding import utf8
-from ..runtime.errors import InputError
-from ..runtime.limits import check_solve
-from ..runtime.warning_codes import note
-from ..solver.result import DeformResult
-from ..solver.settings import resolve
-from ..solver.stop import StopReason
-from .animation import FRAME_FIELDS, Animator, FrameState, fingerprint, unreached_keys
+from ...io.handles import load_handles, referenced_files
+from ...io.mesh import format_mesh, frame_formatter
+from ...io.solve_log import LOG_FORMATS, format_log
+from ...runtime import exit_codes
+from ...runtime.commit import commit_files
+from ...runtime.encoding import utf8
+from ...runtime.errors import InputError
+from ...runtime.limits import check_solve
+from ...runtime.warning_codes import note
+from ...solver.result import DeformResult
+from ...solver.settings import resolve
+from ...solver.stop import StopReason
+from ..preflight import check_output_path, read_any_mesh, refuse_overwrite
 from .frame_files import MAX_FRAMES, check_pattern, frame_count, frames_on_disk, remove_stale, suffix
-from .preflight import check_output_path, read_any_mesh, refuse_overwrite
+from .sequence import FRAME_FIELDS, Animator, FrameState, fingerprint, unreached_keys
 
 #: the resume state, in the frames' folder
 STATE_NAME = ".srarap-animate-state.npz"

@@ -13,25 +13,25 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..io.mesh.formats import FORMATS, MeshFormat, by_extension, extensions
-from ..io.solve_log import LOG_FORMATS, format_log
-from ..runtime import descriptors, memory
-from ..runtime.commit import commit_files
-from ..runtime.encoding import utf8
-from ..runtime.errors import NumericalError, OutputError, UsageProblem
-from ..runtime.failures import classify
-from ..runtime.limits import check_solve
-from ..runtime.stages import ended as stage_ended
-from ..solver.settings import resolve
-from ..solver.stop import StopReason
-from .distortion import vertex_distortion
+from ...io.mesh.formats import FORMATS, MeshFormat, by_extension, extensions
+from ...io.solve_log import LOG_FORMATS, format_log
+from ...runtime import descriptors, memory
+from ...runtime.commit import commit_files
+from ...runtime.encoding import utf8
+from ...runtime.errors import NumericalError, OutputError, UsageProblem
+from ...runtime.failures import classify
+from ...runtime.limits import check_solve
+from ...runtime.stages import ended as stage_ended
+from ...solver.settings import resolve
+from ...solver.stop import StopReason
+from ..distortion import vertex_distortion
+from ..info import up_axis
+from ..job_status import JobResult, JobStatus
+from ..pictures import preview_png
+from ..pipeline import deform_mesh, refuse_warnings
+from ..preflight import check_output_path, load_posed, read_any_mesh, refuse_overwrite
 from .golden import check_golden
-from .info import up_axis
-from .job_record import fingerprint, read_record, record_bytes, sidecar_path
-from .job_status import JobResult, JobStatus
-from .pipeline import deform_mesh, refuse_warnings
-from .preflight import check_output_path, load_posed, read_any_mesh, refuse_overwrite
-from .preview import preview_png
+from .record import fingerprint, read_record, record_bytes, sidecar_path
 
 __all__ = ["DeformJob", "JobResult", "JobStatus", "recorded_result", "run_job",
            "run_job_safely"]

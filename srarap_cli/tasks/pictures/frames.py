@@ -5,8 +5,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..io.handles import Constraints
-from ..io.mesh.mesh import Mesh
+from ...io.handles import Constraints
+from ...io.mesh.mesh import Mesh
 from .preview import preview_png
 
 #: a contact sheet shows at most this many frames (evenly spread, first and last included)

@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from ..io.mesh.mesh import Mesh
-from ..solver.libigl import igl
+from ...io.mesh.mesh import Mesh
+from ...solver.libigl import igl
 
 
 def same_topology(a: Mesh, b: Mesh) -> bool:

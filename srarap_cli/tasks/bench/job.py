@@ -6,17 +6,17 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..io.handles import load_handles
-from ..io.mesh import read_mesh
-from ..runtime.commit import commit_files
-from ..runtime.encoding import utf8
-from ..runtime.errors import UsageProblem
-from ..runtime.limits import check_solve
-from ..solver.settings import resolve
-from .bench import ALL_METHODS, IGL, run_methods
-from .bench_report import curves_csv, plot_png, summary_json, table
-from .pipeline import problem
-from .preflight import check_output_path, refuse_overwrite
+from ...io.handles import load_handles
+from ...io.mesh import read_mesh
+from ...runtime.commit import commit_files
+from ...runtime.encoding import utf8
+from ...runtime.errors import UsageProblem
+from ...runtime.limits import check_solve
+from ...solver.settings import resolve
+from ..pipeline import problem
+from ..preflight import check_output_path, refuse_overwrite
+from .methods import ALL_METHODS, IGL, run_methods
+from .report import curves_csv, plot_png, summary_json, table
 
 CHOICES = ALL_METHODS + (IGL,)
 # bench measures how fast each method approaches the minimum, so it runs far past the usual

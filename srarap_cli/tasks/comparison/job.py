@@ -4,16 +4,16 @@ import json
 from dataclasses import dataclass
 from typing import Any
 
-from ..io.mesh.formats import MeshFormat
-from ..runtime import exit_codes
-from ..runtime.commit import commit_files
-from ..runtime.encoding import utf8
-from ..runtime.errors import UsageProblem
-from .batch.job_pictures import compare_pictures
-from .batch.report import junit_xml, report_html
+from ...io.mesh.formats import MeshFormat
+from ...runtime import exit_codes
+from ...runtime.commit import commit_files
+from ...runtime.encoding import utf8
+from ...runtime.errors import UsageProblem
+from ..job_status import JobResult, JobStatus
+from ..pictures import compare_pictures
+from ..preflight import check_output_path, read_any_mesh, refuse_overwrite
+from ..reports import junit_xml, report_html
 from .compare import Comparison, Verdict, compare_meshes
-from .job_status import JobResult, JobStatus
-from .preflight import check_output_path, read_any_mesh, refuse_overwrite
 
 
 @dataclass(frozen=True)

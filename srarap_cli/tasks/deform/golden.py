@@ -3,9 +3,9 @@ beyond the tolerance."""
 from collections.abc import Mapping
 from typing import Any
 
-from ..io.mesh import read_mesh
-from .compare import compare_meshes
-from .job_status import JobResult, JobStatus
+from ...io.mesh import read_mesh
+from ..comparison import compare_meshes
+from ..job_status import JobResult, JobStatus
 
 
 def check_golden(result: JobResult, expect: Mapping[str, Any], out: str) -> None:

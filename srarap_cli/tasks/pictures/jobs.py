@@ -8,17 +8,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..io.handles import load_handles
-from ..io.mesh import read_mesh
-from ..io.mesh.formats import MeshFormat
-from ..io.solve_log import read_log
-from ..runtime.commit import commit_files
-from ..runtime.errors import InputError, UsageProblem
-from .frame_files import frame_paths
+from ...io.handles import load_handles
+from ...io.mesh import read_mesh
+from ...io.mesh.formats import MeshFormat
+from ...io.solve_log import read_log
+from ...runtime.commit import commit_files
+from ...runtime.errors import InputError, UsageProblem
+from ..animate import frame_paths
+from ..info import up_axis, up_decided
+from ..preflight import check_output_path, read_any_mesh, refuse_overwrite
 from .frames import animated_gif, contact_sheet, frame_pictures, sheet_choice
-from .info import up_axis, up_decided
 from .log_axis import decades_axis
-from .preflight import check_output_path, read_any_mesh, refuse_overwrite
 from .preview import preview_png
 from .render import VIEWS
 

@@ -11,7 +11,7 @@ import re
 from collections.abc import Sequence
 from xml.sax.saxutils import escape, quoteattr
 
-from ..job_status import JobResult, JobStatus
+from .job_status import JobResult, JobStatus
 
 COLOURS = {"failed": "#c62828", "regressed": "#c62828", "not-converged": "#ef6c00",
            "interrupted": "#6d4c41", "ok": "#2e7d32", "up-to-date": "#558b2f"}

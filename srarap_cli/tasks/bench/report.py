@@ -3,8 +3,8 @@ import io
 import json
 from typing import Any
 
-from ..io.solve_log import LOG_FIELDS, format_log
-from .bench import IGL, SR_METHODS, MethodRun
+from ...io.solve_log import LOG_FIELDS, format_log
+from .methods import IGL, SR_METHODS, MethodRun
 
 COLUMNS = [("method", "method", "{}"), ("iterations", "iters", "{}"),
            ("ms_per_iteration", "ms/iter", "{:.2f}"), ("iterations_to_1%", "it@1%", "{}"),

@@ -20,16 +20,16 @@ from typing import Any
 
 import numpy as np
 
-from ..io.documents import document_bytes
-from ..io.handles import Constraints
-from ..io.mesh.mesh import Mesh
-from ..runtime.errors import InputError, excerpt
-from ..runtime.warning_codes import note
-from ..solver.quaternion import align_hemisphere, multiply, normalize
-from ..solver.result import DeformResult
-from ..solver.settings import Settings
-from .job_record import deciding
-from .pipeline import command_solver, problem, scatter
+from ...io.documents import document_bytes
+from ...io.handles import Constraints
+from ...io.mesh.mesh import Mesh
+from ...runtime.errors import InputError, excerpt
+from ...runtime.warning_codes import note
+from ...solver.quaternion import align_hemisphere, multiply, normalize
+from ...solver.result import DeformResult
+from ...solver.settings import Settings
+from ..deform import deciding
+from ..pipeline import command_solver, problem, scatter
 
 FRAME_FIELDS = ("frame", "iterations", "membrane", "bending", "total", "converged",
                 "min_rotor_dot", "seconds", "stop")

@@ -2,12 +2,12 @@
 did not converge, and ``-v``'s pointer to ``--cache``."""
 import math
 
-from ..runtime import signals
-from ..runtime.clock import elapsed
-from ..solver.multires.size import AUTO_THRESHOLD
-from ..solver.result import DeformResult
-from ..solver.settings import Settings
-from ..solver.stop import StopReason
+from ...runtime import signals
+from ...runtime.clock import elapsed
+from ...solver.multires.size import AUTO_THRESHOLD
+from ...solver.result import DeformResult
+from ...solver.settings import Settings
+from ...solver.stop import StopReason
 
 
 def wall_seconds(result: DeformResult) -> float:

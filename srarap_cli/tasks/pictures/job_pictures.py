@@ -2,17 +2,19 @@
 mesh on the surface, its energy curve. Drawn by the worker that solved the job."""
 import io
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ...io.handles import Constraints
 from ...io.mesh.mesh import Mesh
-from ..compare import Comparison
 from ..info import up_axis
-from ..log_axis import decades_axis
-from ..preview import UP
-from ..render import face_colors, render_png
+from .log_axis import decades_axis
+from .preview import UP
+from .render import face_colors, render_png
+
+if TYPE_CHECKING:  # the comparison wing draws with these pictures: no import at run time
+    from ..comparison import Comparison
 
 #: each picture's size in pixels: a report of 100 jobs stays a few megabytes
 THUMBNAIL = (240, 200)
@@ -65,11 +67,11 @@ def energy_picture(log: Sequence[dict[str, Any]]) -> bytes:
     return buf.getvalue()
 
 
-def compare_pictures(a: Mesh, b: Mesh, found: Comparison, tol: float) -> dict[str, str]:
+def compare_pictures(a: Mesh, b: Mesh, found: "Comparison", tol: float) -> dict[str, str]:
     """``compare``'s report pictures (base64 PNG): ``shape``, B over A ghosted (when they
     share vertices), and ``difference``, B coloured by each vertex's distance to A (in
     ``found``'s unit)."""
-    from .report import encode_png
+    from ..reports import encode_png
 
     out = {}
     if found.mode == "per-vertex":

@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..solver.deformer import Deformer
-from ..solver.libigl import igl
-from ..solver.settings import Settings
+from ...solver.deformer import Deformer
+from ...solver.libigl import igl
+from ...solver.settings import Settings
 
 ACCELERATED = "+anderson"
 SR_METHODS = ("sr-linear", "sr-linear-sym", "sr-relax", "sr-linear-sym" + ACCELERATED)

@@ -5,9 +5,9 @@ import os
 import re
 import string
 
-from ..io.mesh.formats import extensions, suffix_of
-from ..runtime.errors import InputError, OutputError, UsageProblem
-from .preflight import check_output_path
+from ...io.mesh.formats import extensions, suffix_of
+from ...runtime.errors import InputError, OutputError, UsageProblem
+from ..preflight import check_output_path
 
 #: frames an animation may have unless raised on purpose (a typo in --fps or a keyframe time
 #: would otherwise fill the disk)

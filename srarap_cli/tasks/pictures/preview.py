@@ -3,9 +3,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..io.handles import Constraints
-from ..io.mesh.mesh import Mesh
-from .distortion import vertex_distortion
+from ...io.handles import Constraints
+from ...io.mesh.mesh import Mesh
+from ..distortion import vertex_distortion
 from .render import face_colors, render_png
 
 #: Proper rotations taking each axis name to +z, the renderer's up.

@@ -7,10 +7,10 @@ from collections.abc import Mapping, Sequence
 from importlib import metadata
 from typing import Any
 
-from ..io.handles import referenced_files
-from ..io.input_files import read_input_bytes
-from ..runtime.errors import InputError
-from ..solver.stop import StopReason
+from ...io.handles import referenced_files
+from ...io.input_files import read_input_bytes
+from ...runtime.errors import InputError
+from ...solver.stop import StopReason
 
 #: what a record keeps of a job's result
 RECORDED = ("status", "iterations", "energy", "stop", "warnings")

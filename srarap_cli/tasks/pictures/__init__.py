@@ -1,0 +1,21 @@
+"""Pictures: meshes drawn headless (``render``), ``deform --preview`` (``preview``), an
+animation's frames as a GIF or a contact sheet (``frames``), the batch report's pictures of a
+job (``job_pictures``), log axes (``log_axis``), and the jobs of ``srarap render`` and ``srarap
+plot`` (``jobs``: :class:`~.jobs.RenderJob`, :func:`~.jobs.run_render`, :class:`~.jobs.PlotJob`,
+:func:`~.jobs.run_plot`). Names are imported on first use.
+"""
+import importlib
+from typing import Any
+
+_WHERE = {"RenderJob": "jobs", "run_render": "jobs", "PlotJob": "jobs", "run_plot": "jobs",
+          "VIEWS": "render", "render_png": "render", "preview_png": "preview",
+          "compare_pictures": "job_pictures", "difference_picture": "job_pictures",
+          "energy_picture": "job_pictures", "shape_picture": "job_pictures"}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
