@@ -28,7 +28,7 @@ from ...runtime.warning_codes import note
 from ...solver.quaternion import align_hemisphere, multiply, normalize
 from ...solver.result import DeformResult
 from ...solver.settings import Settings
-from ..deform import deciding
+from ..deciding import deciding
 from ..pipeline import command_solver, problem, scatter
 
 FRAME_FIELDS = ("frame", "iterations", "membrane", "bending", "total", "converged",

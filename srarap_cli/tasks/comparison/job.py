@@ -5,14 +5,15 @@ from dataclasses import dataclass
 from typing import Any
 
 from ...io.mesh.formats import MeshFormat
+from ...io.mesh.mesh import Mesh
 from ...runtime import exit_codes
 from ...runtime.commit import commit_files
 from ...runtime.encoding import utf8
 from ...runtime.errors import UsageProblem
 from ..job_status import JobResult, JobStatus
-from ..pictures import compare_pictures
+from ..pictures import difference_picture, shape_picture
 from ..preflight import check_output_path, read_any_mesh, refuse_overwrite
-from ..reports import junit_xml, report_html
+from ..reports import encode_png, junit_xml, report_html
 from .compare import Comparison, Verdict, compare_meshes
 
 
@@ -103,3 +104,15 @@ def run_compare(job: CompareJob) -> CompareOutcome:
             files.append((job.junit, utf8(junit_xml([row], "compare"))))
     commit_files(files)
     return done
+
+
+def compare_pictures(a: Mesh, b: Mesh, found: Comparison, tol: float) -> dict[str, str]:
+    """``compare``'s report pictures (base64 PNG): ``shape``, B over A ghosted (when they
+    share vertices), and ``difference``, B coloured by each vertex's distance to A (in
+    ``found``'s unit)."""
+    out = {}
+    if found.mode == "per-vertex":
+        out["shape"] = encode_png(shape_picture(a, b, None))
+    out["difference"] = encode_png(difference_picture(a, b, found.of_b(len(b.vertices)), tol,
+                                                      found.scale))
+    return out

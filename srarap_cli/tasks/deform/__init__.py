@@ -12,7 +12,7 @@ from typing import Any
 _WHERE = {"DeformJob": "job", "run_job": "job", "run_job_safely": "job", "recorded_result": "job",
           "check_golden": "golden", "summary_line": "advice", "cache_hint": "advice",
           "fingerprint": "record", "sidecar_path": "record", "JobStatus": "job",
-          "deciding": "record", "JobResult": "job"}
+          "JobResult": "job"}
 
 __all__ = sorted(_WHERE)
 

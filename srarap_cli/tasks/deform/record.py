@@ -11,6 +11,7 @@ from ...io.handles import referenced_files
 from ...io.input_files import read_input_bytes
 from ...runtime.errors import InputError
 from ...solver.stop import StopReason
+from ..deciding import deciding
 
 #: what a record keeps of a job's result
 RECORDED = ("status", "iterations", "energy", "stop", "warnings")
@@ -33,16 +34,6 @@ def fingerprint(mesh: str, handles: str, settings: Mapping[str, Any], output: st
     h.update(json.dumps([deciding(settings), output, metadata.version("srarap-cli")],
                         sort_keys=True).encode())
     return h.hexdigest()
-
-
-#: settings that do not change what a job writes: the thread count (byte-identical outputs)
-NOT_DECIDING = ("threads",)
-
-
-def deciding(settings: Mapping[str, Any]) -> dict[str, Any]:
-    """``settings`` less those that do not change the outputs (:data:`NOT_DECIDING`): what
-    a fingerprint hashes, so that a rerun with another thread count is up to date."""
-    return {k: v for k, v in settings.items() if k not in NOT_DECIDING}
 
 
 def read_record(sidecar: str, key: str) -> dict[str, Any] | None:

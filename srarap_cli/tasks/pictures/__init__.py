@@ -9,7 +9,7 @@ from typing import Any
 
 _WHERE = {"RenderJob": "jobs", "run_render": "jobs", "PlotJob": "jobs", "run_plot": "jobs",
           "VIEWS": "render", "render_png": "render", "preview_png": "preview",
-          "compare_pictures": "job_pictures", "difference_picture": "job_pictures",
+          "difference_picture": "job_pictures",
           "energy_picture": "job_pictures", "shape_picture": "job_pictures"}
 
 __all__ = sorted(_WHERE)

@@ -1,6 +1,5 @@
 # The wing's names for type checkers: the package loads them lazily (__init__.py's
 # __getattr__). Keep in step with _WHERE there (tests/test_layers.py checks it).
-from .job_pictures import compare_pictures as compare_pictures
 from .job_pictures import difference_picture as difference_picture
 from .job_pictures import energy_picture as energy_picture
 from .job_pictures import shape_picture as shape_picture

@@ -2,7 +2,7 @@
 mesh on the surface, its energy curve. Drawn by the worker that solved the job."""
 import io
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -12,9 +12,6 @@ from ..info import up_axis
 from .log_axis import decades_axis
 from .preview import UP
 from .render import face_colors, render_png
-
-if TYPE_CHECKING:  # the comparison wing draws with these pictures: no import at run time
-    from ..comparison import Comparison
 
 #: each picture's size in pixels: a report of 100 jobs stays a few megabytes
 THUMBNAIL = (240, 200)
@@ -65,17 +62,3 @@ def energy_picture(log: Sequence[dict[str, Any]]) -> bytes:
     fig.savefig(buf, format="png", metadata={"Software": None})
     plt.close(fig)
     return buf.getvalue()
-
-
-def compare_pictures(a: Mesh, b: Mesh, found: "Comparison", tol: float) -> dict[str, str]:
-    """``compare``'s report pictures (base64 PNG): ``shape``, B over A ghosted (when they
-    share vertices), and ``difference``, B coloured by each vertex's distance to A (in
-    ``found``'s unit)."""
-    from ..reports import encode_png
-
-    out = {}
-    if found.mode == "per-vertex":
-        out["shape"] = encode_png(shape_picture(a, b, None))
-    out["difference"] = encode_png(difference_picture(a, b, found.of_b(len(b.vertices)), tol,
-                                                      found.scale))
-    return out
