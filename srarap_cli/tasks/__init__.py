@@ -1,5 +1,8 @@
-"""What a command does, as plain functions of meshes and handles: deform a mesh (``pipeline``),
-animate, batch, compare, bench, render, preview, distortion, samples.
+"""What a command does, callable from Python, in wings: ``deform``, ``animate``,
+``comparison``, ``pictures``, ``bench``, ``batch`` (each a package with one entry: a frozen job,
+a ``run_*`` function and its outcome), and what they share (``pipeline``, ``preflight``,
+``job_status``, ``reports``, ``deciding``, ``info``, ``rigid_parts``, ``distortion``,
+``samples``, ``api``). A wing reaches another only through its package.
 
 Rule: imports ``io``, ``solver`` and ``runtime``; never ``cli`` (no Click, no exit codes, no
 printing of summaries: those belong to the command line).
