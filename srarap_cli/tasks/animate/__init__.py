@@ -6,8 +6,7 @@ The entry: a frozen :class:`~.job.AnimateJob`, :func:`~.job.run_animation` and i
 :class:`~.job.AnimationOutcome` (``exit_code``, ``warnings``, ``summary()``). Names are imported
 on first use.
 """
-import importlib
-from typing import Any
+from ...runtime.lazy_names import lazy_getattr
 
 _WHERE = {"AnimateJob": "job", "run_animation": "job", "AnimationOutcome": "job",
           "Animator": "sequence", "MAX_FRAMES": "frame_files", "frame_paths": "frame_files"}
@@ -15,7 +14,4 @@ _WHERE = {"AnimateJob": "job", "run_animation": "job", "AnimationOutcome": "job"
 __all__ = sorted(_WHERE)
 
 
-def __getattr__(name: str) -> Any:
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+__getattr__ = lazy_getattr(__name__, _WHERE)

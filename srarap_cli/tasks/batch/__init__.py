@@ -7,8 +7,7 @@ jobs that did not finish (``rows``), and the summary files, report and JUnit it 
 Names are imported on first use, and nothing here imports ``worker_start``, which changes the
 signals of the process that imports it.
 """
-import importlib
-from typing import Any
+from ...runtime.lazy_names import lazy_getattr
 
 _WHERE = {"run_batch": "run", "BatchInterrupted": "rows", "load_manifest": "manifest",
           "check_outputs": "manifest", "write_summaries": "summary", "write_reports": "summary",
@@ -17,7 +16,4 @@ _WHERE = {"run_batch": "run", "BatchInterrupted": "rows", "load_manifest": "mani
 __all__ = sorted(_WHERE)
 
 
-def __getattr__(name: str) -> Any:
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+__getattr__ = lazy_getattr(__name__, _WHERE)

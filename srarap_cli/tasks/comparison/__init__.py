@@ -3,8 +3,7 @@
 verdict against a tolerance (``verdict``); the command's job (``job``: :class:`~.job.CompareJob`,
 :func:`~.job.run_compare`, :class:`~.job.CompareOutcome`). Names are imported on first use.
 """
-import importlib
-from typing import Any
+from ...runtime.lazy_names import lazy_getattr
 
 _WHERE = {"Comparison": "compare", "Verdict": "compare", "compare_meshes": "compare",
           "CompareJob": "job", "CompareOutcome": "job", "run_compare": "job"}
@@ -12,7 +11,4 @@ _WHERE = {"Comparison": "compare", "Verdict": "compare", "compare_meshes": "comp
 __all__ = sorted(_WHERE)
 
 
-def __getattr__(name: str) -> Any:
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+__getattr__ = lazy_getattr(__name__, _WHERE)

@@ -6,8 +6,7 @@ The entry: a frozen :class:`~.job.DeformJob`, :func:`~.job.run_job`, and its out
 :class:`~srarap_cli.tasks.job_status.JobResult` (exit code, warnings). Other wings reach it
 through this package; names are imported on first use.
 """
-import importlib
-from typing import Any
+from ...runtime.lazy_names import lazy_getattr
 
 _WHERE = {"DeformJob": "job", "run_job": "job", "run_job_safely": "job", "recorded_result": "job",
           "check_golden": "golden", "summary_line": "advice", "cache_hint": "advice",
@@ -17,7 +16,4 @@ _WHERE = {"DeformJob": "job", "run_job": "job", "run_job_safely": "job", "record
 __all__ = sorted(_WHERE)
 
 
-def __getattr__(name: str) -> Any:
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+__getattr__ = lazy_getattr(__name__, _WHERE)

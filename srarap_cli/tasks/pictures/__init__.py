@@ -4,8 +4,7 @@ job (``job_pictures``), log axes (``log_axis``), and the jobs of ``srarap render
 plot`` (``jobs``: :class:`~.jobs.RenderJob`, :func:`~.jobs.run_render`, :class:`~.jobs.PlotJob`,
 :func:`~.jobs.run_plot`). Names are imported on first use.
 """
-import importlib
-from typing import Any
+from ...runtime.lazy_names import lazy_getattr
 
 _WHERE = {"RenderJob": "jobs", "run_render": "jobs", "PlotJob": "jobs", "run_plot": "jobs",
           "VIEWS": "render", "render_png": "render", "preview_png": "preview",
@@ -15,7 +14,4 @@ _WHERE = {"RenderJob": "jobs", "run_render": "jobs", "PlotJob": "jobs", "run_plo
 __all__ = sorted(_WHERE)
 
 
-def __getattr__(name: str) -> Any:
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+__getattr__ = lazy_getattr(__name__, _WHERE)
