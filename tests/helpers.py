@@ -54,6 +54,14 @@ def tube(length=6.0, rings=12, segments=8):
     return m.vertices, m.triangles()[0]
 
 
+def tube_handles(top, length=6.0, more=""):
+    """A handle file (YAML text) for a tube along z of ``length``: its base ring held, its top
+    ring doing ``top`` (a YAML flow action, ``rotate: {...}``), then the groups ``more``."""
+    return ("groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
+            f"  top: {{box: {{min: [-2, -2, {length - 0.01}], max: [2, 2, {length + 0.01}]}},"
+            f" {top}}}\n" + more)
+
+
 def ends(V, length=6.0):
     """Ids of the two end rings (and cap centres) of a tube."""
     return np.flatnonzero((V[:, 2] < 1e-9) | (V[:, 2] > length - 1e-9))

@@ -177,17 +177,15 @@ def test_the_dry_run_warns_what_deform_warns_on_a_mesh_of_several_parts(tmp_path
     part carried off rigidly and a part nothing holds. Three tubes: one bent by its handles,
     one moved whole by a group, one held by nothing; ``info --json`` (its warnings and the
     mesh's problems) says exactly what ``deform`` says."""
-    from helpers import run_cli, tube
+    from helpers import run_cli, tube, tube_handles
 
     V, F = tube(length=6.0, rings=8, segments=6)
     W = np.vstack([V, V + [5.0, 0, 0], V + [10.0, 0, 0]])
     G = np.vstack([F, F + len(V), F + 2 * len(V), F[:1]])  # and one face twice
     write_mesh(str(tmp_path / "m.obj"), Mesh.from_arrays(W, G))
-    (tmp_path / "h.yaml").write_text(
-        "groups:\n  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
-        "  top: {box: {min: [-2, -2, 5.99], max: [2, 2, 6.01]}, rotate: {axis: [0, 0, 1], "
-        f"{turn}}}}}\n  whole: {{box: {{min: [3, -2, -1], max: [7, 2, 7]}}, "
-        "translate: [0, 0, 1]}\n")
+    (tmp_path / "h.yaml").write_text(tube_handles(
+        f"rotate: {{axis: [0, 0, 1], {turn}}}",
+        more="  whole: {box: {min: [3, -2, -1], max: [7, 2, 7]}, translate: [0, 0, 1]}\n"))
     dry = run_cli(["info", "m.obj", "h.yaml", "--json"], cwd=tmp_path)
     assert dry.returncode == 0, dry.stderr
     doc = json.loads(dry.stdout)

@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 import pytest
-from helpers import ROOT, ends, run_cli, tube, twist
+from helpers import ROOT, ends, run_cli, tube, tube_handles, twist
 
 from srarap_cli.io.mesh import Mesh, write_mesh
 from srarap_cli.runtime import parallel
@@ -202,11 +202,8 @@ def _big_tube(tmp_path, length=10.0):
     assert len(V) > max(2 * parallel.BLOCK_ROWS, 20_000)
     assert cell_graph(V, F).I.size > operators.EDGE_BLOCK
     write_mesh(str(tmp_path / "tube.obj"), Mesh.from_arrays(V, F))
-    (tmp_path / "h.yaml").write_text(
-        "groups:\n"
-        "  base: {box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}\n"
-        f"  top: {{box: {{min: [-2, -2, {length - 0.01}], max: [2, 2, {length + 0.01}]}},"
-        " rotate: {axis: [0, 0, 1], angle_deg: 90}}\n")
+    (tmp_path / "h.yaml").write_text(tube_handles("rotate: {axis: [0, 0, 1], angle_deg: 90}",
+                                                  length))
 
 
 def _srarap(tmp_path, *args, env=None):

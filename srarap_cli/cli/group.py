@@ -9,6 +9,7 @@ from click.core import Command, Context
 from click.formatting import HelpFormatter
 
 from ..runtime import descriptors, exit_codes, limits, signals, streams
+from ..runtime.errors import InputError
 from ..runtime.lazy_modules import defer_unused_numpy_modules
 from ..runtime.threads import pin_process
 
@@ -57,7 +58,7 @@ class LazyGroup(click.Group):
             with signals.deferred():
                 defer_unused_numpy_modules()
                 found = getattr(importlib.import_module(f".{module}", __package__), attr)
-        except limits.InputError as exc:
+        except InputError as exc:
             _leave_now(exit_codes.INVALID_INPUT, str(exc))
         except (MemoryError, ImportError, OSError) as exc:
             if not (isinstance(exc, MemoryError) or limits.is_out_of_memory(exc)):

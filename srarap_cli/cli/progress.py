@@ -52,8 +52,10 @@ class SolveProgress:
             return
         self.last, self.shown = now, True
         level = f"{row.get('level', 'full resolution')}, " if self.levels else ""
-        text = (f"{level}iteration {row['iteration']}  energy {row['total']:.6g}  "
-                f"change {row['rel_change']:.2g}  {now:.1f} s")
+        self._show(f"{level}iteration {row['iteration']}  energy {row['total']:.6g}  "
+                   f"change {row['rel_change']:.2g}  {now:.1f} s")
+
+    def _show(self, text: str) -> None:
         # on a terminal the line is cleared first: a shorter one left the longer one's tail
         sys.stderr.write(f"\r\033[K{text}" if self.terminal else f"srarap: progress: {text}\n")
         sys.stderr.flush()
@@ -91,7 +93,5 @@ class FrameProgress(SolveProgress):
             return  # a short run says nothing; a long one's last frame is said
         self.last, self.shown = now, True
         rate = done / max(now, 1e-9)
-        text = (f"frame {done}/{total}  {rate:.2f} frames/s  "
-                f"ETA {(total - done) / max(rate, 1e-9):.0f} s  {now:.1f} s")
-        sys.stderr.write(f"\r\033[K{text}" if self.terminal else f"srarap: progress: {text}\n")
-        sys.stderr.flush()
+        self._show(f"frame {done}/{total}  {rate:.2f} frames/s  "
+                   f"ETA {(total - done) / max(rate, 1e-9):.0f} s  {now:.1f} s")

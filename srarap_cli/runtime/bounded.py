@@ -147,4 +147,4 @@ def _reap(pid: int, kill: bool) -> None:
             os.kill(pid, signal.SIGKILL)
         os.waitpid(pid, 0)
     except (ChildProcessError, ProcessLookupError):
-        pass
+        pass  # already gone and reaped: nothing left to wait for

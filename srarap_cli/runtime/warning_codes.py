@@ -134,6 +134,12 @@ def as_note(w: str) -> "Note | str":
     return w
 
 
+def coded(w: str, code: str) -> Note:
+    """``w`` as a :class:`Note`: its own code where it has one, else ``code``."""
+    found = as_note(w)
+    return found if isinstance(found, Note) else note(code, w)
+
+
 def kind_of(w: str) -> str:
     """A warning's kind; one without a code (a plug-in's) counts as the request's."""
     found = as_note(w)

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...runtime.warning_codes import Note, as_note, note
+from ...runtime.warning_codes import coded
 from .mesh import Mesh
 from .normals import recompute_normals
 from .obj import format_obj, obj_frames, read_obj
@@ -75,8 +75,7 @@ class MeshFormat:
         if mesh.unkept:
             lost = lost + [f"not written: {'; '.join(mesh.unkept)} of the input (srarap "
                            "keeps vertices, faces and per-vertex properties)"]
-        return data, [as_note(w) if isinstance(as_note(w), Note) else note("format-drops", w)
-                      for w in lost]
+        return data, [coded(w, "format-drops") for w in lost]
 
     def frame_writer(self, mesh: Mesh) -> Callable[[np.ndarray], bytes]:
         """``frame(positions) -> bytes``: the file of ``mesh`` with other positions (n, 3)."""

@@ -44,11 +44,7 @@ def interrupted_row(job: Job, out_dir: str | None = None, keep_unconverged: bool
     spec = None if out_dir is None else deform_job(job, out_dir, keep_unconverged)
     done = None if spec is None else recorded_result(spec)
     if spec is not None and done is not None:
-        try:
-            fresh = since is not None and os.path.getmtime(sidecar_path(spec.output)) >= since
-        except OSError:
-            fresh = False
-        if fresh:
+        if since is not None and _recorded_since(spec, since):
             done.solved, done.message = True, "finished as the batch was stopped"
             if done.status is JobStatus.UP_TO_DATE:
                 done.status = JobStatus.OK
@@ -62,15 +58,17 @@ def solved_since(row: JobResult, job: Job, out_dir: str, since: float) -> JobRes
     ``since`` (the batch's start): this batch solved it, and a second run of it found its
     own outputs (a Dask worker that a signal or a crash stopped after the commit, its task
     run again). Other rows as they are."""
-    if row.status is not JobStatus.UP_TO_DATE:
-        return row
-    try:
-        fresh = os.path.getmtime(sidecar_path(deform_job(job, out_dir).output)) >= since
-    except OSError:
-        fresh = False
-    if fresh:
+    if row.status is JobStatus.UP_TO_DATE and _recorded_since(deform_job(job, out_dir), since):
         row.status, row.exit_code, row.solved = JobStatus.OK, JobStatus.OK.exit_code, True
     return row
+
+
+def _recorded_since(spec: DeformJob, since: float) -> bool:
+    """Whether ``spec``'s record was written at ``since`` (the batch's start) or later."""
+    try:
+        return os.path.getmtime(sidecar_path(spec.output)) >= since
+    except OSError:
+        return False
 
 
 def lost_row(job: Job, exitcode: int) -> JobResult:

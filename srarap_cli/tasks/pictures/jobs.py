@@ -30,7 +30,7 @@ UP_NOTE = ("srarap: note: drawn with +y up: the mesh's extents do not tell which
            "(most OBJ and PLY files are y-up); --up z if it stands on z")
 
 
-def parse_size(text: str) -> tuple[int, int]:
+def pixel_size(text: str) -> tuple[int, int]:
     """``WIDTHxHEIGHT`` as two ints of 16 to 8000 pixels; UsageProblem else."""
     try:
         w, h = (int(x) for x in text.lower().split("x"))
@@ -79,7 +79,7 @@ def run_render(job: RenderJob, on_note: Callable[[str], None] | None = None) -> 
         _frames(job, on_note)
         return job.out
     check_output_path(job.out, (".png",), "output")
-    size = parse_size(job.size or "800x600")
+    size = pixel_size(job.size or "800x600")
     for view in job.views:
         check_view(view)
     refuse_overwrite([job.out], mesh=job.mesh, handles=job.handles,
@@ -105,7 +105,7 @@ def _frames(job, on_note):
         raise UsageProblem("a frame pattern takes --handles, --view (one), --up, --size "
                            "and --fps; not --rest, --color, --layout or several views")
     check_view(job.views[0])
-    size = parse_size(job.size or "480x360")
+    size = pixel_size(job.size or "480x360")
     paths = frame_paths(job.mesh)
     gif = job.out.lower().endswith(".gif")
     if gif and len(paths) > MAX_GIF_FRAMES:
@@ -145,7 +145,7 @@ def run_plot(job: PlotJob) -> str:
     """Plot ``job``; returns the file written."""
     check_output_path(job.out, (".png",), "output")
     refuse_overwrite([job.out], others=[("log", path) for path in job.logs])
-    w, h = parse_size(job.size)
+    w, h = pixel_size(job.size)
     tables = [(path, read_log(path)) for path in job.logs]  # every log checked first
     import matplotlib
     matplotlib.use("Agg")
