@@ -22,7 +22,8 @@ LINE = re.compile(r"^srarap: warning: .* \[([a-z-]+)\]( \(\d+ times\))?$")
 
 
 def _calls():
-    """(path, line, code or None) of every ``note(...)`` and ``ctx.warn(...)`` in the package."""
+    """(path, line, code or None) of every ``note(...)``, ``ctx.warn(...)`` and
+    ``coded(text, code)`` in the package."""
     out = []
     for folder, _, files in os.walk(PACKAGE):
         for name in files:
@@ -35,7 +36,11 @@ def _calls():
                 f = node.func
                 called = f.id if isinstance(f, ast.Name) else f.attr if isinstance(
                     f, ast.Attribute) else ""
-                if called in ("note", "warn") and node.args and not (
+                if called == "coded" and len(node.args) == 2:
+                    second = node.args[1]
+                    out.append((os.path.relpath(path, ROOT), node.lineno,
+                                second.value if isinstance(second, ast.Constant) else None))
+                elif called in ("note", "warn") and node.args and not (
                         isinstance(f, ast.Attribute) and called == "warn"
                         and getattr(f.value, "id", "") in ("warnings", "logging")):
                     first = node.args[0]
