@@ -115,6 +115,13 @@ def test_a_short_vertex_line_is_not_made_up_from_the_next_one(tmp_path):
         read_mesh(str(path))
 
 
+def test_a_line_continued_by_a_backslash_is_one_line(tmp_path):
+    joined, continued = tmp_path / "joined.obj", tmp_path / "continued.obj"
+    joined.write_text(SQUARE + "f 1 2 3\nf 2 4 3\n")
+    continued.write_text(SQUARE.replace("v 1 0 0", "v 1 \\\n0 0") + "f 1 2 \\\n3\nf 2 4 3\n")
+    assert_same_mesh(read_mesh(str(continued)), read_mesh(str(joined)))
+
+
 def test_line_breaks_other_than_newline_go_line_by_line():
     for odd in ("\r", "\x0c", "\u2028"):
         assert obj._read_bulk(SQUARE + "f 1 2 3" + odd + "f 2 4 3\n") is None
