@@ -13,6 +13,7 @@ from srarap_cli.runtime import parallel
 from srarap_cli.runtime.errors import InputError
 from srarap_cli.runtime.parallel import at_most, map_blocks, row_blocks, using_threads
 from srarap_cli.solver import linalg, one_triangle, operators
+from srarap_cli.solver.multires.simplify import simplify_to_subset
 from srarap_cli.solver.oneshot import make_deformer
 from srarap_cli.solver.operators import cell_graph
 from srarap_cli.tasks.batch.run import job_threads
@@ -149,6 +150,20 @@ def every_threshold(monkeypatch):
     monkeypatch.setattr(operators, "EDGE_BLOCK", 500)
     monkeypatch.setenv(one_triangle.ENV, "rslab")
     monkeypatch.setattr(linalg, "ONE_TRIANGLE_FROM", 0)
+
+
+def test_the_simplification_is_the_same_at_any_thread_count(every_threshold):
+    """Its collapse costs and shape checks run in blocks (of 96 edges and 24 collapses
+    here): the coarse mesh must not depend on how many threads took them."""
+    V, F = tube(length=8.0, rings=60, segments=32)
+    coarse = []
+    for threads in (1, 2, 3):
+        with using_threads(threads):
+            coarse.append(simplify_to_subset(V, F, 300))
+    assert 250 <= len(coarse[0].vertices) <= 450
+    for other in coarse[1:]:
+        assert np.array_equal(other.vertices, coarse[0].vertices)
+        assert np.array_equal(other.faces, coarse[0].faces)
 
 
 def _solve(V, F, ids, T, threads, **options):

@@ -12,9 +12,13 @@ changes the faces, neighbours or quadrics another one was checked against, and n
 moves, so every check made at the start of the round still holds when all are applied.
 """
 
+from functools import partial
+
 import numpy as np
 import scipy.sparse as sp
 
+from ...runtime import parallel
+from ...runtime.parallel import by_rows
 from ..group_rotations import label_sum
 from ..mesh_checks import edge_counts
 from ..operators import triangle_normals
@@ -247,7 +251,13 @@ def _any(owner, flags, size):
 
 def _keeps_shape(V, surface, rings, u, v):
     """Whether moving u's triangles onto v keeps each one's orientation (against the
-    triangle it was and against the input surface) and a fair shape."""
+    triangle it was and against the input surface) and a fair shape; collapse by collapse,
+    blocks of them side by side."""
+    return by_rows(partial(_block_keeps_shape, V, surface, rings), np.empty(u.size, dtype=bool),
+                   u, v, size=max(1, parallel.BLOCK_ROWS // 4))
+
+
+def _block_keeps_shape(V, surface, rings, u, v):
     owner, faces = rings.star(u)
     T = rings.F[faces]
     keep = ~np.any(T == v[owner, None], axis=1)
@@ -382,16 +392,24 @@ def _lifted(V):
     ones doubled, so that a quadric's error at x is a dot product."""
     i, j = np.triu_indices(4)
     x = np.column_stack([V, np.ones(len(V))])
-    return x[:, i] * x[:, j] * np.where(i == j, 1.0, 2.0)
+    # row-major: the product of the two column gathers comes out column-major, and np.take
+    # of rows copied the whole array at every call (a tenth of the simplification's time)
+    return np.ascontiguousarray(x[:, i] * x[:, j] * np.where(i == j, 1.0, 2.0))
 
 
-def _costs(Q, lifted, u, v, chunk=1 << 20):
-    """Quadric error of moving u onto v: (v,1)^T (Q_u + Q_v) (v,1)."""
-    own = np.einsum("ik,ik->i", Q, lifted)
-    out = np.empty(u.size)
-    for s in range(0, u.size, chunk):
-        uu, vv = u[s:s + chunk], v[s:s + chunk]
-        # np.take gathers rows 2-3 times faster than fancy indexing (same values)
-        out[s:s + chunk] = (np.einsum("ik,ik->i", np.take(Q, uu, axis=0),
-                                      np.take(lifted, vv, axis=0)) + np.take(own, vv))
-    return np.maximum(out, 0.0)
+def _costs(Q, lifted, u, v):
+    """Quadric error of moving u onto v: (v,1)^T (Q_u + Q_v) (v,1); edge by edge, so blocks
+    of edges run side by side and the answer is the same at any thread count."""
+    # each vertex's own term summed in column order, as numpy summed it while ``lifted`` was
+    # column-major: the same coarse meshes, bit for bit
+    own = Q[:, 0] * lifted[:, 0]
+    for k in range(1, Q.shape[1]):
+        own += Q[:, k] * lifted[:, k]
+
+    def block(uu, vv):
+        # np.take gathers rows 2-3 times faster than fancy indexing (same values), and a
+        # block's gathers stay in cache: 16k edges a block, 2.6 times faster than 1M
+        return np.maximum(np.einsum("ik,ik->i", np.take(Q, uu, axis=0),
+                                    np.take(lifted, vv, axis=0)) + np.take(own, vv), 0.0)
+
+    return by_rows(block, np.empty(u.size), u, v)
