@@ -36,6 +36,22 @@ def test_nested_dissection_back_end_solves_spd_systems(monkeypatch, superlu):
     assert solve(b[:, 0]).shape == (30,)
 
 
+@pytest.mark.parametrize("approximate", [False, True])
+@pytest.mark.parametrize("path", PATHS + ["unsymmetric"])
+def test_every_path_answers_row_major(monkeypatch, path, approximate):
+    """A block of rows of the answer is gathered and multiplied many times a step: an answer
+    in column order (SuperLU's own) made each of those copy the whole array first."""
+    rng = np.random.default_rng(3)
+    M = sp.random(40, 40, density=0.2, random_state=4)
+    A = (M @ M.T + sp.eye(40)).tocsr()
+    _use("minimum degree" if path == "unsymmetric" else path, monkeypatch)
+    monkeypatch.setattr(linalg, "ONE_TRIANGLE_FROM", 0)
+    b = rng.standard_normal((40, 3))
+    x = linalg.factor(A, symmetric=path != "unsymmetric", approximate=approximate)(b)
+    assert x.flags.c_contiguous and x.dtype == np.float64
+    assert np.abs(A @ x - b).max() < (1e-4 if approximate else 1e-10)
+
+
 def test_large_mesh_back_end_gives_the_same_deformation(monkeypatch, superlu):
     V, F = tube(length=6.0, rings=12, segments=8)
     ids = ends(V, 6.0)

@@ -139,9 +139,11 @@ def _nested_dissection(A, order, scale=1.0):
 
 def _solver(lu, dtype, scale=1.0):
     """``solve(b)`` of ``scale`` times the matrix SuperLU factored into ``lu`` (of precision
-    ``dtype``), answering in double precision."""
+    ``dtype``), answering in double precision, row-major as rslab answers: SuperLU's
+    column-major answer made every row gather (``np.take``) and sparse product of a block of
+    rows copy the whole array first (a coarse level's positions, a dozen times a step)."""
     if dtype != np.float32:
-        return lu.solve
+        return lambda b: np.ascontiguousarray(lu.solve(b))
 
     def solve(b):
         b = np.asarray(b, dtype=float)
@@ -152,7 +154,7 @@ def _solver(lu, dtype, scale=1.0):
         np.divide(b, size, out=B, casting="same_kind")
         with _flushed(True):
             X = lu.solve(B)
-        return np.multiply(X, size / scale, dtype=float)
+        return np.multiply(X, size / scale, out=np.empty(X.shape), dtype=float)
 
     return solve
 
