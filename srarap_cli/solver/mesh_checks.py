@@ -76,6 +76,21 @@ def edge_adjacency(F: np.ndarray, n: int) -> csr_matrix:
     return sp.csr_matrix((np.ones(F.size), (F.ravel(), F[:, [1, 2, 0]].ravel())), shape=(n, n))
 
 
+def distinct_ids(ids: np.ndarray, n: int) -> np.ndarray:
+    """The distinct values of ``ids`` (any shape, all in ``0..n-1``), sorted: what
+    ``np.unique`` gives, by one pass over a mask of ``n`` instead of a hash or sort of the ids
+    (a 1.2M-vertex mesh's faces: 7.4M ids, about 0.6 s by ``np.unique``).
+
+    Examples
+    --------
+    >>> distinct_ids(np.array([[3, 1, 2], [2, 1, 0]]), 5).tolist()
+    [0, 1, 2, 3]
+    """
+    mask = np.zeros(n, dtype=bool)
+    mask[np.asarray(ids).ravel()] = True
+    return np.flatnonzero(mask)
+
+
 def edge_counts(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Undirected edges (e, 2) of triangles F (sorted pairs, in lexicographic order) and how
     many triangles hold each.

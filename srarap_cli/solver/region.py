@@ -3,6 +3,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .mesh_checks import distinct_ids
+
 
 @dataclass
 class Submesh:
@@ -49,7 +51,7 @@ def restrict(V: np.ndarray, F: np.ndarray, ids: np.ndarray, targets: np.ndarray,
     movable[region] = True
     movable[ids] = False
     faces = F[movable[F].any(axis=1)]
-    verts = np.unique(faces)
+    verts = distinct_ids(faces, len(V))
     local = np.full(len(V), -1)
     local[verts] = np.arange(verts.size)
     full_targets = V[verts].copy()

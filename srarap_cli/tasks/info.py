@@ -7,7 +7,7 @@ from ..io.handles import Constraints
 from ..io.handles.transforms import ROUNDING, vector_text
 from ..io.mesh import Mesh
 from ..solver.group_rotations import group_rotors
-from ..solver.mesh_checks import edge_adjacency, edge_counts, mesh_warnings
+from ..solver.mesh_checks import distinct_ids, edge_adjacency, edge_counts, mesh_warnings
 from ..solver.quaternion import to_matrix
 from ..solver.settings import resolve
 from .pipeline import model_warnings, problem, request_warnings
@@ -37,7 +37,7 @@ def mesh_info(mesh: Mesh) -> dict:
     F = mesh.triangles()[0]
     lo, hi = V.min(axis=0), V.max(axis=0)
     components, loops = _components(F, len(V)), _boundary_loops(F)
-    used = np.unique(F).size
+    used = distinct_ids(F, len(V)).size
     euler = used - len(edge_counts(F)[0]) + len(F)
     twice_genus = 2 * components - loops - euler
     problems = mesh_warnings(V, F)

@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from ...runtime import parallel
 from ...runtime.parallel import by_rows
 from ..group_rotations import label_sum
-from ..mesh_checks import edge_counts
+from ..mesh_checks import distinct_ids, edge_counts
 from ..operators import triangle_normals
 
 #: Weight of the point quadric (distance to the collapsed original vertices) relative to the
@@ -67,7 +67,7 @@ def collapse_to(V: np.ndarray, F: np.ndarray, size: int, frozen: np.ndarray) -> 
     Q = _vertex_quadrics(V, F)
     surface = _vertex_normals(V, F)
     lifted = _lifted(V)
-    alive = np.unique(F).size
+    alive = distinct_ids(F, len(V)).size
     banned = np.empty(0, dtype=np.int64)
     best = _Best(len(V))
     while alive > size:

@@ -21,7 +21,7 @@ from .. import api_checks
 from ..deformer import Deformer, solve_settings
 from ..drivers import corrected_driver
 from ..group_rotations import connected_groups, group_rotors
-from ..mesh_checks import edge_adjacency
+from ..mesh_checks import distinct_ids, edge_adjacency
 from ..quaternion import IDENTITY
 from ..result import STAGE_NAMES, DeformResult, MultiresPart
 from ..settings import Settings, with_keywords
@@ -227,7 +227,7 @@ class MultiresDeformer:
         """The full-resolution Deformer when the simplification kept more than half the
         vertices (a triangle soup, a mesh of tiny parts): a coarse level would cost about
         as much as the mesh itself. None otherwise."""
-        kept, used = self.coarse.vertices.size, np.unique(self.F).size
+        kept, used = self.coarse.vertices.size, distinct_ids(self.F, len(self.V)).size
         if kept <= NO_GAIN * used:
             return None
         self.fine.warnings.append(note("multires-no-gain", f"multires: the mesh simplifies only "

@@ -4,7 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse import csgraph
 
-from ..mesh_checks import edge_counts
+from ..mesh_checks import distinct_ids, edge_counts
 
 
 def topology_summary(F: np.ndarray, n: int) -> dict[str, int | bool]:
@@ -28,7 +28,7 @@ def topology_summary(F: np.ndarray, n: int) -> dict[str, int | bool]:
     """
     F = np.asarray(F, dtype=np.int64)
     edges, count = edge_counts(F)
-    used = np.unique(F)
+    used = distinct_ids(F, n)
     adj = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
     components = csgraph.connected_components(adj, directed=False)[1][used]
     border = edges[count == 1]
@@ -36,7 +36,8 @@ def topology_summary(F: np.ndarray, n: int) -> dict[str, int | bool]:
     if len(border):
         badj = sp.coo_matrix((np.ones(len(border)), (border[:, 0], border[:, 1])), shape=(n, n))
         labels = csgraph.connected_components(badj, directed=False)[1]
-        loops = np.unique(labels[np.unique(border)]).size
+        loops = distinct_ids(labels[distinct_ids(border, n)], n).size
     return {"euler": int(used.size - len(edges) + len(F)),
-            "components": int(np.unique(components).size),
+            "components": int(distinct_ids(components, n).size),
             "boundary_loops": int(loops), "edge_manifold": bool(count.max(initial=0) <= 2)}
+
