@@ -67,11 +67,13 @@ def collapse_to(V: np.ndarray, F: np.ndarray, size: int, frozen: np.ndarray) -> 
     Q = _vertex_quadrics(V, F)
     surface = _vertex_normals(V, F)
     lifted = _lifted(V)
+    own = _own_error(Q, lifted)
     alive = distinct_ids(F, len(V)).size
     banned = np.empty(0, dtype=np.int64)
     best = _Best(len(V))
     while alive > size:
-        u, v, invalid = _round(V, lifted, surface, F, Q, frozen, banned, alive - size, best)
+        u, v, invalid = _round(V, (lifted, own), surface, F, Q, frozen, banned, alive - size,
+                               best)
         if not u.size:
             if not banned.size:
                 break
@@ -81,6 +83,7 @@ def collapse_to(V: np.ndarray, F: np.ndarray, size: int, frozen: np.ndarray) -> 
             continue
         banned = np.union1d(banned, invalid)
         Q[v] += Q[u]
+        own[v] = _own_error(Q[v], lifted[v])  # only the quadrics that changed
         relabel = np.arange(len(V))
         relabel[u] = v
         F = relabel[F]
@@ -89,10 +92,11 @@ def collapse_to(V: np.ndarray, F: np.ndarray, size: int, frozen: np.ndarray) -> 
     return F
 
 
-def _round(V, lifted, surface, F, Q, frozen, banned, need, best):
+def _round(V, error, surface, F, Q, frozen, banned, need, best):
     """One round: the vertices to delete, the vertices they collapse into, and the keys
     (u n + v) of proposals that won but failed the checks (left out of later rounds).
-    ``best`` (a :class:`_Best`) keeps each vertex's proposal between rounds.
+    ``error``: the lifted positions and own errors :func:`_costs` takes; ``best`` (a
+    :class:`_Best`) keeps each vertex's proposal between rounds.
 
     Checks run only on the winners: most proposals pass them, and checking every vertex's
     proposal each round cost several times the rest of the round."""
@@ -110,7 +114,7 @@ def _round(V, lifted, surface, F, Q, frozen, banned, need, best):
     # a border vertex may only slide along the border, so boundaries keep their shape
     ok = ~fixed[u] & (c <= 2) & (~border[u] | (c == 1)) & ~_isin_sorted(u * n + v, banned)
     u, v, c = u[ok], v[ok], c[ok]
-    cost = _costs(Q, lifted, u, v)
+    cost = _costs(Q, *error, u, v)
     first = _cheapest_per_vertex(u, v, cost, n)
     u, v, c, cost = best.update(u[first], v[first], c[first], cost[first])
     if u.size > 1:
@@ -397,14 +401,19 @@ def _lifted(V):
     return np.ascontiguousarray(x[:, i] * x[:, j] * np.where(i == j, 1.0, 2.0))
 
 
-def _costs(Q, lifted, u, v):
-    """Quadric error of moving u onto v: (v,1)^T (Q_u + Q_v) (v,1); edge by edge, so blocks
-    of edges run side by side and the answer is the same at any thread count."""
-    # each vertex's own term summed in column order, as numpy summed it while ``lifted`` was
-    # column-major: the same coarse meshes, bit for bit
+def _own_error(Q, lifted):
+    """Each vertex's quadric at itself, ``(x,1)^T Q (x,1)`` (n,), summed in column order, as
+    numpy summed it while ``lifted`` was column-major: the same coarse meshes, bit for bit."""
     own = Q[:, 0] * lifted[:, 0]
     for k in range(1, Q.shape[1]):
         own += Q[:, k] * lifted[:, k]
+    return own
+
+
+def _costs(Q, lifted, own, u, v):
+    """Quadric error of moving u onto v: (v,1)^T (Q_u + Q_v) (v,1), with ``own`` the
+    :func:`_own_error` of every vertex; edge by edge, so blocks of edges run side by side and
+    the answer is the same at any thread count."""
 
     def block(uu, vv):
         # np.take gathers rows 2-3 times faster than fancy indexing (same values), and a
