@@ -385,20 +385,23 @@ def _border_quadrics(V, F, unit, n):
     return label_sum(q, a, n) + label_sum(q, b, n)
 
 
-def _outer(p):
-    """Upper triangles (row-major, 10 entries) of the outer products p p^T, p (m, 4)."""
-    i, j = np.triu_indices(4)
-    return p[:, i] * p[:, j]
+def _outer(p, doubled=False):
+    """Upper triangles (row-major, 10 entries) of the outer products p p^T, p (m, 4); with
+    ``doubled``, the off-diagonal entries times two. Row-major, made column by column:
+    gathering the ten columns by index took 0.5 to 1.4 s at 2.4M faces, this 0.08 s (the same
+    values), and a take of rows from a column-major result copied it whole at every call."""
+    out = np.empty((p.shape[0], 10))
+    for k, (a, b) in enumerate(zip(*np.triu_indices(4))):
+        np.multiply(p[:, a], p[:, b], out=out[:, k])
+        if doubled and a != b:
+            out[:, k] *= 2.0
+    return out
 
 
 def _lifted(V):
     """(n, 10) monomials of (x, 1) matching the upper-triangle quadric layout, off-diagonal
     ones doubled, so that a quadric's error at x is a dot product."""
-    i, j = np.triu_indices(4)
-    x = np.column_stack([V, np.ones(len(V))])
-    # row-major: the product of the two column gathers comes out column-major, and np.take
-    # of rows copied the whole array at every call (a tenth of the simplification's time)
-    return np.ascontiguousarray(x[:, i] * x[:, j] * np.where(i == j, 1.0, 2.0))
+    return _outer(np.column_stack([V, np.ones(len(V))]), doubled=True)
 
 
 def _own_error(Q, lifted):
