@@ -52,20 +52,63 @@ def run_bounded(func: Callable[..., Any], *args: Any, seconds: float,
     space beyond what it starts with (None: no memory bound). Returns its result or raises
     its exception (both pickled back); raises :class:`OutOfTime` or :class:`OutOfMemory`
     past a bound. A signal that ends this process kills the child first."""
-    if not hasattr(os, "fork") or os.environ.get(ENV_OFF) == "0":
-        return func(*args)
+    with start_bounded(func, *args, seconds=seconds, memory=memory) as call:
+        return call.result()
+
+
+def start_bounded(func: Callable[..., Any], *args: Any, seconds: float,
+                  memory: int | None, here: bool = False) -> "Pending":
+    """:func:`run_bounded` started, not waited for: this process goes on (reads another
+    file, say) while the child works; :meth:`Pending.result` waits. Use it in a ``with``
+    block: leaving the block without the result (an error, a signal) kills the child. With
+    ``here`` (or without ``os.fork``, or with ``SRARAP_BOUNDED=0``) the call runs in this
+    process at :meth:`Pending.result`, unbounded."""
+    if here or not hasattr(os, "fork") or os.environ.get(ENV_OFF) == "0":
+        return Pending(lambda: func(*args))
     read, write = os.pipe()
     pid = os.fork()
     if pid == 0:  # the child: never returns
         os.close(read)
         _child(write, func, args, memory)
     os.close(write)
-    data = None
-    try:
-        data = _collect(read, seconds)
-    finally:
-        os.close(read)
-        _reap(pid, kill=data is None)
+    return Pending(None, (pid, read, time.monotonic() + seconds, seconds))
+
+
+class Pending:
+    """A call of :func:`start_bounded`: in a child process, or to run here."""
+
+    def __init__(self, here: Callable[[], Any] | None,
+                 child: tuple[int, int, float, float] | None = None) -> None:
+        self._here, self._child = here, child
+        #: the child's process id (None: the call runs here)
+        self.pid = None if child is None else child[0]
+
+    def result(self) -> Any:
+        """The call's result, or its exception raised here (see :func:`run_bounded`)."""
+        if self._child is None:
+            return self._here() if self._here is not None else None
+        pid, read, end, seconds = self._child
+        self._child = None
+        data = None
+        try:
+            data = _collect(read, end, seconds)
+        finally:
+            os.close(read)
+            _reap(pid, kill=data is None)
+        return _decoded(data)
+
+    def __enter__(self) -> "Pending":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._child is not None:  # left without its result: the child goes too
+            pid, read, _, _ = self._child
+            self._child = None
+            os.close(read)
+            _reap(pid, kill=True)
+
+
+def _decoded(data: bytes | None) -> Any:
     kind, value = pickle.loads(data) if data else ("died", None)
     if kind == "ok":
         return value
@@ -122,10 +165,10 @@ def _address_space_used() -> int:
         return 0
 
 
-def _collect(read: int, seconds: float) -> bytes:
-    """Everything the child writes, until it closes the pipe; OutOfTime past ``seconds``."""
+def _collect(read: int, end: float, seconds: float) -> bytes:
+    """Everything the child writes, until it closes the pipe; OutOfTime past ``end`` (the
+    monotonic clock's time ``seconds`` after the start)."""
     chunks: list[bytes] = []
-    end = time.monotonic() + seconds
     while True:
         left = end - time.monotonic()
         if left <= 0:

@@ -1,9 +1,12 @@
 """Read and write mesh files by format; see the package's docstring."""
+import contextlib
 import os
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
+from ...runtime.bounded import OutOfMemory, OutOfTime, start_bounded, time_bound
 from ...runtime.commit import atomic_write
 from ...runtime.errors import InputError, OutputError
 from ...runtime.limits import MAX_COORDINATE, check_read
@@ -29,6 +32,36 @@ def read_mesh(path: str | os.PathLike, fmt: MeshFormat | None = None) -> Mesh:
     TypeError : ``path`` is not a path.
     """
     return open_mesh(path, fmt)[0]
+
+
+@contextlib.contextmanager
+def reading_beside(path: str | None) -> Iterator[Callable[[], Mesh | None]]:
+    """``read_mesh(path)`` in a child process while this one reads another file: the block
+    gets a function that waits for the mesh (None for no ``path``) or raises what
+    :func:`read_mesh` raises. Leaving the block early stops the child. Two 738k-vertex OBJ
+    files, one each side, take the time of one (a parse holds the GIL: threads would not).
+    Read here, at the call, where other threads run (a fork copies only the thread that
+    makes it) or where ``SRARAP_BOUNDED=0``.
+    """
+    if path is None:
+        yield lambda: None
+        return
+    try:
+        seconds = time_bound(os.path.getsize(path))
+    except (OSError, TypeError, ValueError):
+        seconds = time_bound(0)  # read_mesh says what is wrong with the path
+    with start_bounded(read_mesh, path, seconds=seconds, memory=None,
+                       here=threading.active_count() > 1) as call:
+        def result() -> Mesh | None:
+            try:
+                return call.result()
+            except OutOfTime:
+                raise InputError(f"{path}: not read in {seconds:.0f} s; stopped (a damaged "
+                                 "file?)") from None
+            except OutOfMemory as exc:
+                raise MemoryError(f"{path}: {exc}") from None
+
+        yield result
 
 
 def open_mesh(path: str | os.PathLike, fmt: MeshFormat | None = None

@@ -114,7 +114,7 @@ def _round(V, error, surface, F, Q, frozen, banned, need, best):
     # a border vertex may only slide along the border, so boundaries keep their shape
     ok = ~fixed[u] & (c <= 2) & (~border[u] | (c == 1)) & ~_isin_sorted(u * n + v, banned)
     u, v, c = u[ok], v[ok], c[ok]
-    cost = _costs(Q, *error, u, v)
+    cost = _costs(Q, error[0], error[1], u, v)
     first = _cheapest_per_vertex(u, v, cost, n)
     u, v, c, cost = best.update(u[first], v[first], c[first], cost[first])
     if u.size > 1:

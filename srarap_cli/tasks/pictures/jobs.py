@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...io.handles import load_handles
-from ...io.mesh import read_mesh
+from ...io.mesh import read_mesh, reading_beside
 from ...io.mesh.formats import MeshFormat
 from ...io.solve_log import read_log
 from ...runtime.commit import commit_files
@@ -84,8 +84,9 @@ def run_render(job: RenderJob, on_note: Callable[[str], None] | None = None) -> 
         check_view(view)
     refuse_overwrite([job.out], mesh=job.mesh, handles=job.handles,
                      others=[("rest mesh", job.rest)] if job.rest else [])
-    shown = read_any_mesh(job.mesh, job.input_format)[0]
-    base = read_mesh(job.rest) if job.rest else None
+    with reading_beside(job.rest) as rest:  # the rest shape read beside the shown one
+        shown = read_any_mesh(job.mesh, job.input_format)[0]
+        base = rest()
     if base is not None and len(base.vertices) != len(shown.vertices):
         raise UsageProblem("--rest: the rest mesh must have the same vertices")
     if job.color == "distortion" and base is None:
