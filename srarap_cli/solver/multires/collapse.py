@@ -72,7 +72,7 @@ def collapse_to(V: np.ndarray, F: np.ndarray, size: int, frozen: np.ndarray) -> 
     banned = np.empty(0, dtype=np.int64)
     best = _Best(len(V))
     while alive > size:
-        u, v, invalid = _round(V, (lifted, own), surface, F, Q, frozen, banned, alive - size,
+        u, v, invalid = _round(V, lifted, own, surface, F, Q, frozen, banned, alive - size,
                                best)
         if not u.size:
             if not banned.size:
@@ -92,11 +92,11 @@ def collapse_to(V: np.ndarray, F: np.ndarray, size: int, frozen: np.ndarray) -> 
     return F
 
 
-def _round(V, error, surface, F, Q, frozen, banned, need, best):
+def _round(V, lifted, own, surface, F, Q, frozen, banned, need, best):
     """One round: the vertices to delete, the vertices they collapse into, and the keys
     (u n + v) of proposals that won but failed the checks (left out of later rounds).
-    ``error``: the lifted positions and own errors :func:`_costs` takes; ``best`` (a
-    :class:`_Best`) keeps each vertex's proposal between rounds.
+    ``lifted``, ``own``: what :func:`_costs` takes; ``best`` (a :class:`_Best`) keeps each
+    vertex's proposal between rounds.
 
     Checks run only on the winners: most proposals pass them, and checking every vertex's
     proposal each round cost several times the rest of the round."""
@@ -114,7 +114,7 @@ def _round(V, error, surface, F, Q, frozen, banned, need, best):
     # a border vertex may only slide along the border, so boundaries keep their shape
     ok = ~fixed[u] & (c <= 2) & (~border[u] | (c == 1)) & ~_isin_sorted(u * n + v, banned)
     u, v, c = u[ok], v[ok], c[ok]
-    cost = _costs(Q, error[0], error[1], u, v)
+    cost = _costs(Q, lifted, own, u, v)
     first = _cheapest_per_vertex(u, v, cost, n)
     u, v, c, cost = best.update(u[first], v[first], c[first], cost[first])
     if u.size > 1:

@@ -40,4 +40,3 @@ def topology_summary(F: np.ndarray, n: int) -> dict[str, int | bool]:
     return {"euler": int(used.size - len(edges) + len(F)),
             "components": int(distinct_ids(components, n).size),
             "boundary_loops": int(loops), "edge_manifold": bool(count.max(initial=0) <= 2)}
-
