@@ -1,5 +1,6 @@
 """After keep_freed_memory, a large temporary comes from the heap and stays there once freed,
-for the next one to reuse (no fresh mapping, no trimming); the results do not change."""
+for the next one to reuse (no fresh mapping, no trimming); after one_arena, another thread
+allocates from the main arena; the results do not change."""
 import os
 import subprocess
 import sys
@@ -40,6 +41,28 @@ def test_a_large_array_comes_from_the_heap_and_stays_for_reuse():
     assert mapped >= 100 and heap < 100  # glibc's default: its own mapping, unmapped on free
     mapped, heap = _megabytes("keep")
     assert mapped < 100 and heap >= 100
+
+
+ARENAS = """
+import ctypes, sys, threading
+import numpy as np
+from srarap_cli.runtime.allocator import one_arena
+if sys.argv[1] == "one":
+    assert one_arena()
+held = []
+thread = threading.Thread(target=lambda: held.append(np.ones(1 << 17)))  # 1 MB from it
+thread.start()
+thread.join()
+ctypes.CDLL(None).malloc_stats()  # one "Arena k:" block per arena, on stderr
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
+def test_after_one_arena_another_thread_allocates_from_the_main_arena():
+    counts = [subprocess.run([sys.executable, "-c", ARENAS, mode], capture_output=True,
+                             text=True, check=True).stderr.count("Arena ")
+              for mode in ("default", "one")]
+    assert counts == [2, 1]
 
 
 def test_a_solve_gives_the_same_bytes_with_memory_kept():

@@ -112,3 +112,15 @@ def test_geometry_span_counts_only_vertices_faces_use():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1e200, 0, 0]])  # the last one unused
     assert geometry_problem(V, F) is None
     assert "too small or too large" in geometry_problem(V * 1e-120, F)
+
+
+def test_solvable_faces_drop_repeated_vertices_and_share_the_faces_when_none_repeats():
+    F = np.array([[0, 1, 2], [2, 2, 3], [1, 3, 2], [4, 5, 4], [5, 6, 6]])
+    assert solvable_faces(F).tolist() == [[0, 1, 2], [1, 3, 2]]
+    whole = F[[0, 2]]
+    same = solvable_faces(whole)
+    # the solve holds them as long as it runs: a copy would be a second array of the faces
+    assert np.shares_memory(same, whole) and np.array_equal(same, whole)
+    with pytest.raises(ValueError):
+        same[0, 0] = 7  # and nothing downstream writes the caller's faces
+    assert whole[0, 0] == 0

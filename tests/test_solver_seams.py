@@ -75,6 +75,37 @@ def test_a_start_registered_from_a_test_file_is_used(bent):
     assert again.converged and again.iterations <= 3  # one full window of the stopping test
 
 
+@pytest.mark.parametrize("accel", ["anderson", "none"])
+def test_the_drivers_let_go_of_the_start_the_solver_handed_over(bent, accel):
+    """The start a solve builds would otherwise live as long as the solve (its caller and
+    the call both hold it): the built-in drivers drop its arrays once past it, and a
+    registered start's own state is left whole (the driver gets a copy)."""
+    V, F, ids, T = bent
+    d = Deformer(V, F, ids)
+    kept, seen = [], []
+
+    def keeping(step, initial):
+        kept.append(STARTS["laplacian"](step, None))
+        return kept[-1]
+
+    def watching(step, state, monitor):
+        seen.append(state)
+        return DRIVERS[{"anderson": "anderson", "none": "plain"}[accel]](step, state, monitor)
+
+    register_start("test-keeping", keeping)
+    try:
+        watched = d.solve(T, start="test-keeping", driver=watching, max_iter=6, tol=0)
+        plain = d.solve(T, start="laplacian", accel=accel, max_iter=6, tol=0)
+    finally:
+        STARTS.pop("test-keeping")
+    (start,), (own,) = seen, kept
+    assert start is not own and start.handed_over and not own.handed_over
+    assert start.positions.size == start.rotors.size == start.covariances.size == 0
+    assert own.positions.shape == V.shape and own.covariances.shape == (len(V), 3, 3)
+    assert np.array_equal(watched.positions, plain.positions)
+    assert [r["total"] for r in watched.log] == [r["total"] for r in plain.log]
+
+
 def test_one_step_is_a_function_of_the_state(bent):
     """Two steps from the same state give the same state; the energy of any pair is the
     state's energy."""

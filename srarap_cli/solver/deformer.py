@@ -7,6 +7,7 @@ when to stop. This class holds what they share: weights, rest edges, the factore
 matrix and the local step.
 """
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -275,7 +276,8 @@ class Deformer:
             raise ValueError(f"start must be one of {', '.join(STARTS)}, not {start!r}")
         if initial is not None and start not in WARM_STARTS:
             start = "warm"
-        first = STARTS[start](step, initial)
+        # a copy: a registered start may return a state it keeps
+        first = replace(STARTS[start](step, initial), handed_over=True)
         run = driver if callable(driver) else DRIVERS.get(driver or ACCEL_DRIVERS[s.accel])
         if run is None:
             raise ValueError(f"driver {driver!r} is not one of {', '.join(map(repr, DRIVERS))} "

@@ -13,8 +13,14 @@ NEEDLE_DEGREES = 1.0
 
 
 def solvable_faces(F: np.ndarray) -> np.ndarray:
-    """Triangles without a repeated vertex (those have no area and no edge to speak of)."""
-    return F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
+    """Triangles without a repeated vertex (those have no area and no edge to speak of):
+    ``F`` itself when every one qualifies (a copy would live as long as the solve)."""
+    keep = (F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])
+    if not keep.all():
+        return F[keep]
+    out = F.view()
+    out.flags.writeable = False  # the caller's faces: nothing downstream may write them
+    return out
 
 
 def geometry_problem(V: np.ndarray, F: np.ndarray) -> str | None:

@@ -1,5 +1,5 @@
 """What one iterate of the local/global iteration is."""
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -17,6 +17,8 @@ class State:
     stretch_total : float, ``sum_i s_i``
     membrane, bending : float, the energy terms of (positions, rotors)
     iteration : int, 0 for a start
+    handed_over : bool, the start a solver built for its driver, which may drop its arrays
+        once it has moved past it (:meth:`release`)
     """
 
     positions: np.ndarray
@@ -27,7 +29,20 @@ class State:
     membrane: float
     bending: float
     iteration: int = 0
+    handed_over: bool = field(default=False, repr=False, compare=False)
+
+    def release(self) -> None:
+        """Drop a handed-over start's arrays; any other state is left as it is.
+
+        The solver that built the start and the call that passes it to the driver both hold
+        it until the solve ends, so without this its arrays outlive their use (1.2M-vertex
+        cylinder: 0.17 GB through the whole solve, 0.15 GB of its peak)."""
+        if self.handed_over:
+            self.positions, self.rotors, self.covariances, self.stretch = _EMPTY
 
     @property
     def total(self) -> float:
         return self.membrane + self.bending
+
+
+_EMPTY = (np.empty((0, 3)), np.empty((0, 4)), np.empty((0, 3, 3)), None)

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..io.handles import Constraints
 from ..io.mesh import Mesh
-from ..runtime.allocator import keep_freed_memory
+from ..runtime.allocator import keep_freed_memory, one_arena
 from ..runtime.errors import InputError
 from ..runtime.stages import ended as stage_ended
 from ..runtime.warning_codes import failing
@@ -99,10 +99,12 @@ def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = N
     they carry off rigidly (:mod:`.rigid_parts`); under ``opts.strict`` the first
     warning is raised instead (before the solver is built, where it can be). The mesh checks
     run before the solver is built, so their temporaries (edge tables of the whole mesh) do
-    not add to the memory it holds (2M-vertex bar: peak 11.4 -> 10.6 GiB); once it is
-    built, the process keeps freed memory for reuse. ``on_warnings`` hears the warnings as
+    not add to the memory it holds (2M-vertex bar: peak 11.4 -> 10.6 GiB); the process's
+    threads share one allocator arena, and once the solver is built, the process keeps freed
+    memory for reuse (:mod:`..runtime.allocator`). ``on_warnings`` hears the warnings as
     they are known, before the setup and before the solve (a log shows them before a long
     run, not after it)."""
+    one_arena()  # before the checks and the setup start threads
     mark = time.perf_counter()
     notes = list(handle_warnings) + mesh_warnings(mesh.vertices, mesh.triangles()[0])
     if constraints is not None:

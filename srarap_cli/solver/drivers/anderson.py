@@ -178,7 +178,7 @@ def anderson_iteration(step: LocalGlobalStep, state: State, monitor: Monitor,
     Parameters
     ----------
     step : LocalGlobalStep
-    state : State, the start
+    state : State, the start (released once it is left behind: :meth:`State.release`)
     monitor : Monitor
     depth : int, Anderson history length (default DEFAULT_DEPTH)
     correction : optional, adds to the rotors of the iterates it is ``due`` for (numbered
@@ -216,6 +216,7 @@ def anderson_iteration(step: LocalGlobalStep, state: State, monitor: Monitor,
         if kind in (None, "fallback"):
             candidate, tried = _local(step, step.positions(R), R, x.iteration + 1)
         stop = monitor.record(tried, current, kind=kind or "plain")
+        x.release()
         x, current = candidate, tried
     return current
 

@@ -1,9 +1,8 @@
+"""The plain fixed-point iteration ``x_{k+1} = G(x_k)``: local step, global step, repeat."""
 from collections.abc import Callable
 
 from ..state import State
 from .monitor import Monitor
-
-"""The plain fixed-point iteration ``x_{k+1} = G(x_k)``: local step, global step, repeat."""
 
 
 def plain_iteration(step: Callable[[State], State], state: State, monitor: Monitor) -> State:
@@ -12,7 +11,7 @@ def plain_iteration(step: Callable[[State], State], state: State, monitor: Monit
     Parameters
     ----------
     step : callable State -> State
-    state : State, the start
+    state : State, the start (released once it is left behind: :meth:`State.release`)
     monitor : Monitor
 
     Returns
@@ -23,5 +22,6 @@ def plain_iteration(step: Callable[[State], State], state: State, monitor: Monit
     while not stop:
         new = step(state)
         stop = monitor.record(new, state)
+        state.release()
         state = new
     return state
