@@ -90,7 +90,8 @@ def test_the_drivers_let_go_of_the_start_the_solver_handed_over(bent, accel):
 
     def watching(step, state, monitor):
         seen.append(state)
-        return DRIVERS[{"anderson": "anderson", "none": "plain"}[accel]](step, state, monitor)
+        seen.append(DRIVERS[{"anderson": "anderson", "none": "plain"}[accel]](step, state, monitor))
+        return seen[-1]
 
     register_start("test-keeping", keeping)
     try:
@@ -98,12 +99,26 @@ def test_the_drivers_let_go_of_the_start_the_solver_handed_over(bent, accel):
         plain = d.solve(T, start="laplacian", accel=accel, max_iter=6, tol=0)
     finally:
         STARTS.pop("test-keeping")
-    (start,), (own,) = seen, kept
+    (start, last), (own,) = seen, kept
     assert start is not own and start.handed_over and not own.handed_over
     assert start.positions.size == start.rotors.size == start.covariances.size == 0
     assert own.positions.shape == V.shape and own.covariances.shape == (len(V), 3, 3)
     assert np.array_equal(watched.positions, plain.positions)
     assert [r["total"] for r in watched.log] == [r["total"] for r in plain.log]
+    # the accelerated driver keeps its iterates settled: no covariances past their local step
+    assert (last.covariances.size == 0) == (accel == "anderson")
+    assert np.array_equal(last.positions, watched.positions)
+
+
+def test_a_settled_state_keeps_positions_rotors_and_energy_and_leaves_the_state_whole(bent):
+    V, F, ids, T = bent
+    step = Deformer(V, F, ids).step_for(T, tol=1e-6)
+    state = step(STARTS["laplacian"](step, None))
+    settled = state.settled()
+    assert settled.covariances.shape == (0, 3, 3) and settled.stretch is None
+    assert settled.positions is state.positions and settled.rotors is state.rotors
+    assert (settled.total, settled.iteration) == (state.total, state.iteration)
+    assert state.covariances.shape == (len(V), 3, 3)
 
 
 def test_one_step_is_a_function_of_the_state(bent):

@@ -1,5 +1,5 @@
 """What one iterate of the local/global iteration is."""
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -12,8 +12,10 @@ class State:
     ----------
     positions : (n, 3) float array
     rotors : (n, 4) float array, unit quaternions (w, x, y, z) of the vertex cells
-    covariances : (n, 3, 3) float array, ``S_i`` of the positions (the next local step's input)
-    stretch : (n,) float array or None, per-cell ``s_i`` (only for steps that use it)
+    covariances : (n, 3, 3) float array, ``S_i`` of the positions (the next local step's
+        input); (0, 3, 3) in a settled state (:meth:`settled`)
+    stretch : (n,) float array or None, per-cell ``s_i`` (only for steps that use it; None in
+        a settled state)
     stretch_total : float, ``sum_i s_i``
     membrane, bending : float, the energy terms of (positions, rotors)
     iteration : int, 0 for a start
@@ -39,6 +41,11 @@ class State:
         cylinder: 0.17 GB through the whole solve, 0.15 GB of its peak)."""
         if self.handed_over:
             self.positions, self.rotors, self.covariances, self.stretch = _EMPTY
+
+    def settled(self) -> "State":
+        """This state without its covariances and per-cell stretch: an iterate past its local
+        step, kept for its positions, rotors and energy (0.1 GB less at 1.2M vertices)."""
+        return replace(self, covariances=_EMPTY[2], stretch=None)
 
     @property
     def total(self) -> float:
