@@ -15,14 +15,13 @@ Run: python benchmarks/machine_threads.py [--repeat 7]
 """
 import argparse
 import os
+import statistics
+import threading
+import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # before numpy: one BLAS thread, as srarap
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # one BLAS thread, as srarap's solves
 
-import statistics  # noqa: E402
-import threading  # noqa: E402
-import time  # noqa: E402
-
-import numpy as np  # noqa: E402
+import numpy as np  # noqa: E402 -- OpenBLAS reads its thread count when numpy loads it
 
 
 def compute():
