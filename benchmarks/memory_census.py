@@ -5,12 +5,13 @@ is allocated at the run's peak, by allocation site.
 memory budget (issue 40). It runs the command's own path (``tasks.pipeline.deform_mesh``,
 with its allocator settings) in this process and prints:
 
-1. after the setup: resident memory, and the arrays, sparse matrices and SuperLU factors
-   reachable from the solver object, summed by owner (attribute path; closures and bound
-   methods followed). A SuperLU factor is counted at 4 bytes of index per entry plus its
-   value size, read from the factor (the precision of a solve's answer; until 2026-11-26
-   this guessed single precision from a size, which counted the double-precision Poisson
-   factor at two thirds of its size);
+1. after the setup: resident memory, and the arrays, sparse matrices and factors reachable
+   from the solver object, summed by owner (attribute path; closures and bound methods
+   followed). An rslab factor is counted at its own ``heap_bytes`` (until 2026-11-28 rslab's
+   factors, the largest holders at 1.2M vertices, were not counted at all); a SuperLU factor
+   at 4 bytes of index per entry plus its value size, read from the factor (the precision of
+   a solve's answer; until 2026-11-26 this guessed single precision from a size, which
+   counted the double-precision Poisson factor at two thirds of its size);
 2. at the highest resident memory seen during the solve (sampled every 0.3 s): the memory
    numpy and Python had allocated (tracemalloc), by allocation site, and what was not theirs
    (SuperLU, libigl, the allocator's free lists).
@@ -45,6 +46,8 @@ def _bytes(obj):
     if sp.issparse(obj):
         return sum(getattr(obj, a).nbytes for a in ("data", "indices", "indptr", "row", "col")
                    if hasattr(obj, a))
+    if type(obj).__module__.startswith("rslab"):  # a factor: its own count of its memory
+        return int(getattr(obj, "heap_bytes", 0))
     if type(obj).__name__ == "SuperLU":
         # SuperLU answers in its factor's precision, whatever the right-hand side's
         value = obj.solve(np.zeros(obj.shape[0], dtype=np.float32)).itemsize
