@@ -58,10 +58,8 @@ class CellGraph:
         ``(K P)_i = sum_j c_ij (p_i - p_j)``. Made when asked for, not held: only setup steps
         ask (the Poisson matrix, connected parts, a transfer's factorization), and a held
         one stayed through every solve (0.12 GB at 1.2M vertices, made in 0.04 s there)."""
-        n = self.n
-        index = np.int32 if max(n, self.I.size) < np.iinfo(np.int32).max else np.int64
-        W = sp.csr_matrix((self.c, self.J.astype(index), self.indptr.astype(index)),
-                          shape=(n, n))
+        # scipy takes 32-bit indices where they fit, as the matrix it was once built from
+        W = sp.csr_matrix((self.c, self.J, self.indptr), shape=(self.n,) * 2)
         return (sp.diags(np.asarray(W.sum(axis=1)).ravel()) - W).tocsr()
 
     @cached_property
