@@ -46,9 +46,15 @@ def test_the_ci_workflow_passes_and_fails_on_drift(tmp_path):
     """The workflow's run steps in order, as GitHub runs them (bash -e), except the install
     step: srarap is installed here already. It publishes what its later steps upload."""
     steps = [s for s in workflow_steps() if s["name"] != "Install srarap"]
-    assert [s["name"] for s in steps] == ["Deform and compare with the goldens"]
-    p = run(["bash", "-e", "-c", steps[0]["run"]], tmp_path)
-    assert p.returncode == 0, p.stderr
+    assert [s["name"] for s in steps] == ["Deform and compare with the goldens", "Job summary"]
+    summary = tmp_path / "step_summary"
+    summary.write_text("")  # GitHub gives each step an empty file
+    for step in steps:
+        p = subprocess.run(["bash", "-e", "-c", step["run"]], cwd=tmp_path, capture_output=True,
+                           text=True, timeout=600,
+                           env={**ENV, "GITHUB_STEP_SUMMARY": str(summary)})
+        assert p.returncode == 0, p.stderr
+    assert summary.read_text().startswith("### srarap batch example-jobs: 2 jobs, all passed")
     uploads = [s["with"] for s in yaml.safe_load(open(os.path.join(
         EXAMPLES, "ci-regression", "mesh-regression.yml")))["jobs"]["regression"]["steps"]
         if "with" in s and ("path" in s["with"] or "report_paths" in s["with"])]
@@ -100,3 +106,24 @@ def test_the_batch_manifest_commands_are_the_ones_its_comments_give():
     text = open(os.path.join(EXAMPLES, "batch", "jobs.yaml")).read()
     assert "srarap batch jobs.yaml -o out --workers 2" in text
     assert "srarap batch jobs.yaml -o out-dask --scheduler local --workers 2" in text
+
+
+@pytest.mark.slow
+def test_the_gitlab_file_writes_what_its_reports_name(tmp_path):
+    """The GitLab file's script, as GitLab runs it (bash -e), except its before_script (the
+    install): every artifact and report it names is written; metrics.txt reads as
+    OpenMetrics, one sample per job and metric."""
+    from prometheus_client.openmetrics.parser import text_string_to_metric_families
+
+    with open(os.path.join(EXAMPLES, "ci-regression", "gitlab-ci.yml")) as fh:
+        job = yaml.safe_load(fh)["mesh-regression"]
+    p = run(["bash", "-e", "-c", "\n".join(job["script"])], tmp_path)
+    assert p.returncode == 0, p.stderr
+    artifacts = job["artifacts"]
+    for path in [*artifacts["paths"], *artifacts["reports"].values()]:
+        assert (tmp_path / path).is_file(), path
+    families = list(text_string_to_metric_families(
+        (tmp_path / artifacts["reports"]["metrics"]).read_text()))
+    assert len(families) == 7
+    assert all([s.labels["job"] for s in f.samples] == ["bar-twist", "bar-bend-paper"]
+               for f in families)

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from helpers import ROOT
+from helpers import ROOT, run_cli
 
 from srarap_cli.cli import main
 from srarap_cli.io.handles import load_handles
@@ -140,17 +140,23 @@ def test_the_handle_file_guide_names_every_key_the_schema_knows():
 
 
 def test_the_guides_manifest_example_is_a_valid_manifest(tmp_path):
+    """The regression guide's manifest, in the layout it describes, loads with its gates and
+    runs: its first run has no golden (exit 8), --update-goldens makes it, then it passes."""
     from srarap_cli.tasks.batch.manifest import load_manifest
-    guide = Path(ROOT, "docs", "guides", "workflows.md").read_text(encoding="utf-8")
+    guide = Path(ROOT, "docs", "guides", "regression.md").read_text(encoding="utf-8")
     block = re.search(r"```yaml\n(.*?)```", guide, re.DOTALL).group(1)
-    (tmp_path / "configs").mkdir()  # the samples' layout, as `srarap samples` writes it
-    os.symlink(Path(ROOT, "sample_meshes"), tmp_path / "sample_meshes")
-    os.symlink(Path(ROOT, "srarap_cli", "data", "golden"), tmp_path / "golden")
-    path = tmp_path / "configs" / "guide-example.yaml"
+    for folder in ("meshes", "handles"):
+        (tmp_path / folder).mkdir()
+    os.symlink(Path(ROOT, "sample_meshes", "bar.obj"), tmp_path / "meshes" / "bar.obj")
+    os.symlink(Path(ROOT, "configs", "bar-twist.yaml"), tmp_path / "handles" / "bar-twist.yaml")
+    path = tmp_path / "regression.yaml"
     path.write_text(block)
     jobs = load_manifest(str(path))
     assert [j["name"] for j in jobs] == ["bar-twist"] and os.path.exists(jobs[0]["mesh"])
-    assert os.path.exists(jobs[0]["expect"]["golden"])
+    assert jobs[0]["expect"].energy_rtol == 1e-4 and jobs[0]["expect"].iterations_within == 3
+    steps = [run_cli(["batch", path, "-o", tmp_path / "out", *extra], cwd=tmp_path).returncode
+             for extra in ([], ["--update-goldens"], [])]
+    assert steps == [8, 8, 0] and (tmp_path / "golden" / "bar-twist.obj").exists()
 
 
 def test_the_guides_make_rule_builds_its_target_and_then_has_nothing_to_do(tmp_path):
@@ -195,7 +201,7 @@ def test_the_python_guide_runs_as_written(tmp_path):
 @pytest.mark.slow
 def test_the_guides_dask_worker_command_serves_a_batch(tmp_path):
     """The worker command as written (host and port filled in) joins a scheduler, and a batch
-    of the guide's manifest runs on it."""
+    of the regression guide's manifest runs on it (its golden written and accepted there)."""
     import shutil
     import signal
     import socket
@@ -206,12 +212,13 @@ def test_the_guides_dask_worker_command_serves_a_batch(tmp_path):
     guide = Path(ROOT, "docs", "guides", "workflows.md").read_text(encoding="utf-8")
     command = re.search(r"```\n(OPENBLAS_NUM_THREADS=1 dask worker .*?)```", guide,
                         re.DOTALL).group(1).strip()
-    manifest = re.search(r"```yaml\n(.*?)```", guide, re.DOTALL).group(1)
-    (tmp_path / "configs").mkdir()
-    os.symlink(Path(ROOT, "sample_meshes"), tmp_path / "sample_meshes")
-    os.symlink(Path(ROOT, "srarap_cli", "data", "golden"), tmp_path / "golden")
-    shutil.copy(Path(ROOT, "configs", "bar-twist.yaml"), tmp_path / "configs")
-    (tmp_path / "configs" / "guide.yaml").write_text(manifest)
+    regression = Path(ROOT, "docs", "guides", "regression.md").read_text(encoding="utf-8")
+    manifest = re.search(r"```yaml\n(.*?)```", regression, re.DOTALL).group(1)
+    for folder in ("meshes", "handles"):
+        (tmp_path / folder).mkdir()
+    shutil.copy(Path(ROOT, "sample_meshes", "bar.obj"), tmp_path / "meshes")
+    shutil.copy(Path(ROOT, "configs", "bar-twist.yaml"), tmp_path / "handles")
+    (tmp_path / "guide.yaml").write_text(manifest)
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
@@ -228,11 +235,13 @@ def test_the_guides_dask_worker_command_serves_a_batch(tmp_path):
                                                                        address)],
                                         env=env, cwd=tmp_path, stdout=subprocess.DEVNULL,
                                         stderr=subprocess.DEVNULL, start_new_session=True))
-        p = subprocess.run([os.path.join(bindir, "srarap"), "batch", "configs/guide.yaml",
-                            "-o", "out", "--scheduler", address], cwd=tmp_path, env=env,
+        p = subprocess.run([os.path.join(bindir, "srarap"), "batch", "guide.yaml",
+                            "-o", "out", "--scheduler", address, "--accept-goldens"],
+                           cwd=tmp_path, env=env,
                            capture_output=True, text=True, timeout=300)
         assert p.returncode == 0, p.stderr[-2000:]
         assert (tmp_path / "out" / "bar-twist.obj").exists()
+        assert (tmp_path / "golden" / "bar-twist.obj").exists()
     finally:
         for proc in started:
             os.killpg(proc.pid, signal.SIGTERM)

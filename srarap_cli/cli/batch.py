@@ -1,6 +1,7 @@
 """``srarap batch``: run a manifest of deformations, skipping what is up to date."""
 import os
 import re
+import shlex
 
 import click
 
@@ -11,6 +12,7 @@ from ..solver.settings import BY_NAME
 from ..tasks.batch import (
     SUMMARIES,
     BatchInterrupted,
+    check_goldens,
     check_outputs,
     load_manifest,
     run_batch,
@@ -43,6 +45,15 @@ SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
               "numbers, a picture of its shape, its difference to the golden mesh and its "
               "energy curve, drawn by the workers; failures and regressions first).")
 @click.option("--junit", help="Also write JUnit XML (one test case per job) for CI systems.")
+@click.option("--summary-md", "markdown", metavar="FILE", help="Also write a Markdown summary "
+              "(a table, failures first) for a GitHub job summary ($GITHUB_STEP_SUMMARY).")
+@click.option("--metrics", metavar="FILE", help="Also write the jobs' figures as OpenMetrics "
+              "(GitLab's metrics report, metrics.txt): iterations, seconds, energy, distances.")
+@click.option("--update-goldens", is_flag=True, help="Write the golden of every job that has "
+              "none or regressed from this run's output (the others are left untouched); "
+              "the run still exits 8: review what was written.")
+@click.option("--accept-goldens", is_flag=True, help="As --update-goldens, and those jobs "
+              "pass: the new results are the truth.")
 @click.option("--threads", type=click.IntRange(min=1), metavar="N",
               help="Threads for each job's solve, at most the CPUs divided by --workers. "
               "[default: $SRARAP_THREADS, else the CPUs divided by --workers]")
@@ -51,14 +62,16 @@ SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
 @click.option("-q", "--quiet", is_flag=True, help="No summary table.")
 @guarded
 def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unconverged: bool,
-          report: str | None, junit: str | None, threads: int | None, strict: str | None,
-          allow: tuple[str, ...] | None, quiet: bool) -> None:
+          report: str | None, junit: str | None, markdown: str | None, metrics: str | None,
+          update_goldens: bool, accept_goldens: bool, threads: int | None,
+          strict: str | None, allow: tuple[str, ...] | None, quiet: bool) -> None:
     """Run every job of MANIFEST (YAML/JSON); a failing job never stops the others.
 
-    Exit code 0 when every job is ok or up to date, 8 when any job failed or regressed
-    against its golden mesh, else 3 when any did not converge (its mesh is not written unless
-    --keep-unconverged; the status is recorded, so an unchanged job reports it again on every
-    rerun without solving). --strict and --allow are each job's, over the manifest's.
+    Exit code 0 when every job is ok or up to date, 8 when any job failed, regressed against
+    its golden mesh or has no golden (--update-goldens writes it), else 3 when any did not
+    converge (its mesh is not written unless --keep-unconverged; the status is recorded, so
+    an unchanged job reports it again on every rerun without solving). --strict and --allow
+    are each job's, over the manifest's.
     """
     if scheduler is not None and scheduler != "local" and not SCHEDULER.fullmatch(scheduler):
         raise click.BadParameter(f"{scheduler!r} is neither 'local' nor a scheduler address "
@@ -67,11 +80,18 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         check_output_path(report, (".html", ".htm"), "--report")
     if junit is not None:
         check_output_path(junit, (".xml",), "--junit")
+    for path, what in ((markdown, "--summary-md"), (metrics, "--metrics")):
+        if path is not None:
+            check_output_path(path, None, what)
+    goldens = "accept" if accept_goldens else "update" if update_goldens else "check"
     jobs = load_manifest(manifest)
     for job in jobs:  # over the manifest's defaults and each job's settings, as in deform
         mine = job["settings"]
         job["settings"] = {**mine, **({"strict": strict} if strict else {}),
                            **({"allow": [*mine.get("allow", ()), *allow]} if allow else {})}
+        job["goldens"] = goldens
+    if goldens != "check":
+        check_goldens(jobs, manifest)
     check_outputs(jobs, out, manifest)
     try:
         os.makedirs(out, exist_ok=True)
@@ -91,7 +111,8 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     # cost the account of the jobs whose outputs are on disk
     write_summaries(rows, out)
     _tell(rows, out, quiet, stopped)
-    write_reports(rows, manifest, report, junit)
+    _tell_goldens(rows, manifest, out, goldens)
+    write_reports(rows, manifest, report, junit, markdown, metrics)
     if stopped is not None:
         raise SystemExit(exit_codes.TERMINATED if isinstance(stopped, Terminated)
                          else exit_codes.INTERRUPTED)
@@ -122,3 +143,21 @@ def _tell(rows, out, quiet, stopped):
         note = (f"; {word}: the jobs not finished are marked interrupted in "
                 f"{os.path.join(out, 'summary.csv')}")
     say(f"srarap batch: {len(rows)} jobs: {summary}{note}")
+
+
+def _tell_goldens(rows, manifest, out, goldens):
+    """What became of the goldens: the command that creates the missing ones, or those this
+    run wrote (said even with -q: a golden written or missing is never silent)."""
+    written = [r for r in rows if r.golden]
+    missing = [r for r in rows if r.status is JobStatus.NO_GOLDEN and not r.golden]
+    if missing:
+        command = shlex.join(["srarap", "batch", manifest, "-o", out, "--update-goldens"])
+        say(f"srarap batch: {len(missing)} job(s) without a golden: {command} creates "
+            f"{'it' if len(missing) == 1 else 'them'} from this run's outputs")
+    if written:
+        what = "; ".join(f"{action}: " + ", ".join(printable(r.job) for r in written
+                                                  if r.golden == action)
+                         for action in dict.fromkeys(r.golden for r in written))
+        after = ("accepted as the truth" if goldens == "accept" else
+                 "review them, then rerun (or --accept-goldens)")
+        say(f"srarap batch: goldens written ({what}); {after}")

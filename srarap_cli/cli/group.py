@@ -21,8 +21,9 @@ COMMANDS = {
     "animate": ("animate", "animate", "Deform MESH through the keyframes of HANDLES, writing "
                                       "one mesh per frame."),
     "compare": ("compare", "compare", "Compare meshes A and B: per vertex when they have the "
-                                      "same vertices and faces, else by the symmetric "
-                                      "Hausdorff distance of their surfaces."),
+                                      "same vertices and faces, else by the distance of "
+                                      "every vertex to the other surface, both ways (both "
+                                      "one-sided distances are said)."),
     "batch": ("batch", "batch", "Run every job of MANIFEST (YAML/JSON); a failing job never "
                                 "stops the others."),
     "info": ("info", "info", "Describe MESH and what HANDLES selects and does, without "

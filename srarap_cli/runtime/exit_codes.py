@@ -38,8 +38,11 @@ TABLE = (
                       "full disk, an output that is a folder",
      "nothing was written or replaced (missing folders are made, and removed again on a "
      "failure)"),
-    ((BEYOND_TOLERANCE,), "`compare`: beyond `--tol`", ""),
-    ((BATCH_FAILED,), "`batch`: a job failed or regressed against its golden mesh",
+    ((BEYOND_TOLERANCE,), "`compare`: beyond `--tol` (or another gate: `--beyond-tol`, "
+                          "`--p95`, `--p99`)", "`--update` writes A to B when B is the "
+                                               "golden, `--accept` exits 0 then"),
+    ((BATCH_FAILED,), "`batch`: a job failed, regressed against its golden mesh or has no "
+                      "golden; `compare --update`: B was missing and is written",
      "see `summary.csv`: each job's `exit_code` is the code `srarap deform` gives for the same "
      "outcome"),
     ((INTERRUPTED, TERMINATED), "interrupted (SIGINT), terminated (SIGTERM); the line says "

@@ -10,8 +10,11 @@ from ..runtime import exit_codes
 #: the columns of a batch's ``summary.csv`` (``summary.json`` holds ``warnings`` as a list;
 #: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason`, empty for a job that
 #: never reached the solver)
+#: ``compare_*``, ``beyond_tol``: the distances to the golden (the unit of ``tol``);
+#: ``golden``: ``created`` or ``updated`` where ``--update-goldens`` wrote it)
 SUMMARY_FIELDS = ("job", "status", "stop", "iterations", "energy", "seconds", "compare_max",
-                  "message", "compare_mean", "tol", "exit_code", "warnings")
+                  "message", "compare_mean", "tol", "exit_code", "compare_p95", "compare_p99",
+                  "beyond_tol", "golden", "warnings")
 #: how warnings are joined in one CSV cell
 WARNING_JOIN = " | "
 
@@ -21,6 +24,7 @@ class JobStatus(enum.Enum):
 
     FAILED = "failed"
     REGRESSED = "regressed"
+    NO_GOLDEN = "no-golden"
     NOT_CONVERGED = "not-converged"
     INTERRUPTED = "interrupted"
     OK = "ok"
@@ -44,13 +48,14 @@ class JobStatus(enum.Enum):
 
     @property
     def fails_batch(self) -> bool:
-        """The job makes its batch fail (exit 8): failed or regressed."""
-        return self in (JobStatus.FAILED, JobStatus.REGRESSED)
+        """The job makes its batch fail (exit 8): failed, regressed or without its golden."""
+        return self in (JobStatus.FAILED, JobStatus.REGRESSED, JobStatus.NO_GOLDEN)
 
 
 def batch_exit_code(statuses: Iterable["JobStatus"]) -> int:
-    """A finished batch's exit code from its jobs' statuses: 8 when any failed or regressed,
-    else 3 when any did not converge, else 0 (a stopped batch exits with its signal's)."""
+    """A finished batch's exit code from its jobs' statuses: 8 when any failed, regressed or
+    has no golden, else 3 when any did not converge, else 0 (a stopped batch exits with its
+    signal's)."""
     statuses = list(statuses)
     if any(s.fails_batch for s in statuses):
         return exit_codes.BATCH_FAILED
@@ -60,6 +65,7 @@ def batch_exit_code(statuses: Iterable["JobStatus"]) -> int:
 _EXIT_CODES = {JobStatus.OK: exit_codes.OK, JobStatus.UP_TO_DATE: exit_codes.OK,
                JobStatus.NOT_CONVERGED: exit_codes.NOT_CONVERGED,
                JobStatus.REGRESSED: exit_codes.BEYOND_TOLERANCE,
+               JobStatus.NO_GOLDEN: exit_codes.BATCH_FAILED,
                JobStatus.INTERRUPTED: exit_codes.INTERRUPTED,
                JobStatus.FAILED: exit_codes.INTERNAL_ERROR}
 
@@ -77,7 +83,10 @@ class JobResult:
     warnings : list of str, every warning of the run (handle file, mesh, solver, output)
     stop : str, the solve's stop reason; iterations, energy: its figures (None unsolved)
     seconds : float, the job's wall time
-    compare_max, compare_mean, tol : distances to the golden mesh and the tolerance
+    compare_max, compare_mean, compare_p95, compare_p99 : distances to the golden mesh, in
+        the unit of ``tol``
+    tol : the tolerance; beyond_tol : the fraction of vertices beyond it
+    golden : ``created`` or ``updated`` where this run wrote the golden, else ""
     solved : bool, the solver ran in this run (False: an unchanged job's recorded result)
     written : str, the output mesh written, or None
     peaks : dict stage -> bytes, peak memory per stage (``-v``)
@@ -99,6 +108,10 @@ class JobResult:
     compare_max: float | None = None
     compare_mean: float | None = None
     tol: float | None = None
+    compare_p95: float | None = None
+    compare_p99: float | None = None
+    beyond_tol: float | None = None
+    golden: str = ""
     solved: bool = False
     written: str | None = None
     peaks: dict[str, int | None] = field(default_factory=dict, repr=False)
@@ -113,7 +126,9 @@ class JobResult:
                 "iterations": self.iterations, "energy": self.energy, "seconds": self.seconds,
                 "compare_max": self.compare_max, "message": self.message,
                 "compare_mean": self.compare_mean, "tol": self.tol, "exit_code": self.exit_code,
-                "warnings": list(self.warnings)}
+                "warnings": list(self.warnings), "compare_p95": self.compare_p95,
+                "compare_p99": self.compare_p99, "beyond_tol": self.beyond_tol,
+                "golden": self.golden}
 
     def shipped(self) -> "JobResult":
         """This result without what stays in the process that ran it (the solve's arrays),

@@ -13,7 +13,8 @@ from xml.sax.saxutils import escape, quoteattr
 
 from .job_status import JobResult, JobStatus
 
-COLOURS = {"failed": "#c62828", "regressed": "#c62828", "not-converged": "#ef6c00",
+COLOURS = {"failed": "#c62828", "regressed": "#c62828", "no-golden": "#c62828",
+           "not-converged": "#ef6c00",
            "interrupted": "#6d4c41", "ok": "#2e7d32", "up-to-date": "#558b2f"}
 PICTURES = (("shape", "rest (ghosted) and result, handles coloured"),
             ("difference", "distance to the golden mesh"),
@@ -62,8 +63,11 @@ def _summary(rows):
            f"({html.escape(worst.job)})" if worst else "")
     warned = sum(bool(r.warnings) for r in rows)
     warned_text = f"; {warned} with warnings" if warned else ""
+    written = [r for r in rows if r.golden]
+    goldens = ("; goldens written by this run: " + ", ".join(
+        f"{html.escape(r.job)} ({r.golden})" for r in written) if written else "")
     return (f"<p class=\"summary\"><b>{len(rows)} jobs</b>: {parts}{warned_text}; "
-            f"{_seconds(seconds, '.1f')} s of solving{far}</p>")
+            f"{_seconds(seconds, '.1f')} s of solving{far}{goldens}</p>")
 
 
 def _job(row, pictures):
@@ -75,7 +79,11 @@ def _job(row, pictures):
                ("energy", _number(row.energy, ".6g")),
                ("to golden: max", _number(row.compare_max, ".3g")),
                ("mean", _number(row.compare_mean, ".3g")),
+               ("p95", _number(row.compare_p95, ".3g")),
+               ("p99", _number(row.compare_p99, ".3g")),
+               ("beyond tol", "-" if row.beyond_tol is None else f"{100 * row.beyond_tol:.3g}%"),
                ("tolerance", _number(row.tol, "g")),
+               ("golden", html.escape(row.golden or "-")),
                ("warnings", str(len(row.warnings)))]
     table = ("<tr>" + "".join(f"<th>{k}</th>" for k, _ in numbers) + "</tr><tr>"
              + "".join(f"<td>{v}</td>" for _, v in numbers) + "</tr>")
@@ -186,8 +194,13 @@ def _detail(row):
     if row.message:
         parts.append(row.message)
     if row.compare_max is not None:
+        beyond = "-" if row.beyond_tol is None else f"{100 * row.beyond_tol:.3g}%"
         parts.append(f"distance to golden: max {row.compare_max:.3g}, mean "
-                     f"{_number(row.compare_mean, '.3g')}, tol {_number(row.tol, 'g')}")
+                     f"{_number(row.compare_mean, '.3g')}, p95 {_number(row.compare_p95, '.3g')}"
+                     f", p99 {_number(row.compare_p99, '.3g')}, beyond tol {beyond}, tol "
+                     f"{_number(row.tol, 'g')}")
+    if row.golden:
+        parts.append(f"golden {row.golden} by this run")
     if row.warnings:
         parts.append(f"{len(row.warnings)} warning(s)")
     return "; ".join(parts)

@@ -10,7 +10,8 @@ signals of the process that imports it.
 from ...runtime.lazy_names import lazy_getattr
 
 _WHERE = {"run_batch": "run", "BatchInterrupted": "rows", "load_manifest": "manifest",
-          "check_outputs": "manifest", "write_summaries": "summary", "write_reports": "summary",
+          "check_outputs": "manifest", "check_goldens": "manifest",
+          "write_summaries": "summary", "write_reports": "summary",
           "run_on_dask": "on_dask", "run_in_processes": "worker_pool", "SUMMARIES": "summary"}
 
 __all__ = sorted(_WHERE)

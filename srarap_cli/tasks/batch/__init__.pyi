@@ -1,5 +1,6 @@
 # The wing's names for type checkers: the package loads them lazily (__init__.py's
 # __getattr__). Keep in step with _WHERE there (tests/test_layers.py checks it).
+from .manifest import check_goldens as check_goldens
 from .manifest import check_outputs as check_outputs
 from .manifest import load_manifest as load_manifest
 from .on_dask import run_on_dask as run_on_dask

@@ -1,6 +1,5 @@
 """A batch manifest: its jobs, with absolute paths and merged settings, and the check that no
 output lands on what a job reads (see :mod:`.batch` for the format)."""
-import math
 import os
 
 from ...io.documents import load_document
@@ -9,17 +8,18 @@ from ...io.mesh.formats import extensions, suffix_of
 from ...runtime.errors import InputError, excerpt, unknown_key
 from ...runtime.paths import leads_out, refuse_overwriting_inputs
 from ...solver.settings import parse_mapping
+from ..comparison import parse_expect, record_path, refuse_leading_out
 from .rows import Job
 
 TOP_KEYS = ("jobs", "defaults")
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
 #: the files a batch writes beside its jobs' in the output folder
 SUMMARIES = ("summary.csv", "summary.json")
-EXPECT_KEYS = ("golden", "tol", "relative")
 
 
 def load_manifest(path: str) -> list[Job]:
-    """Jobs of a manifest, with absolute paths and merged settings (list of dict)."""
+    """Jobs of a manifest, with absolute paths, merged settings and their gates (list of dict;
+    ``golden_root``: the manifest's folder, the only place its goldens may be written)."""
     doc = load_document(path, "json" if path.lower().endswith(".json") else "yaml")
     if isinstance(doc, dict):
         _known(f"{path}", doc, TOP_KEYS, "the manifest")
@@ -47,23 +47,20 @@ def load_manifest(path: str) -> list[Job]:
         names.add(name)
         expect = job.get("expect")
         if expect is not None:
-            if isinstance(expect, dict):
-                _known(where, expect, EXPECT_KEYS, "expect")
-            if not isinstance(expect, dict) or "golden" not in expect:
-                raise InputError(f"{where}: expect needs a golden mesh")
-            tol = expect.get("tol", 0.0)
-            if isinstance(tol, bool) or not isinstance(tol, (int, float)) \
-                    or not math.isfinite(tol) or tol < 0:
-                raise InputError(f"{where}: expect: tol must be a finite number >= 0")
-            expect = {"golden": os.path.join(base, str(expect["golden"])),
-                      "tol": float(tol),
-                      "relative": bool(expect.get("relative", False))}
+            expect = _expect(where, base, expect)
         jobs.append({"name": name, "mesh": os.path.join(base, str(job["mesh"])),
                      "handles": os.path.join(base, str(job["handles"])),
-                     "output": output, "expect": expect,
+                     "output": output, "expect": expect, "golden_root": base,
                      "settings": {**defaults, **_settings(where, "settings",
                                                           job.get("settings", {}))}})
     return jobs
+
+
+def _expect(where, base, spec):
+    """A job's ``expect`` as an Expect, its golden relative to the manifest's folder."""
+    golden = spec.get("golden") if isinstance(spec, dict) else None
+    return parse_expect(spec, lambda message: InputError(f"{where}: {message}"),
+                        None if golden is None else os.path.join(base, str(golden)))
 
 
 def _known(where, mapping, allowed, what):
@@ -109,13 +106,36 @@ def check_outputs(jobs: list[Job],
                    (f"handle file of job {job['name']!r}", job["handles"]),
                    *((f"file named by job {job['name']!r}'s handles", path)
                      for path in referenced_files(job["handles"])),
-                   *([(f"golden mesh of job {job['name']!r}", job["expect"]["golden"])]
+                   *([(f"golden mesh of job {job['name']!r}", job["expect"].golden)]
                      if job["expect"] else [])]
     _stay_inside(jobs, out_dir)
     outputs = [os.path.join(out_dir, name) for job in jobs
                for name in (job["output"], job["output"] + ".srarap.json")]
     outputs += [os.path.join(out_dir, name) for name in SUMMARIES]
     refuse_overwriting_inputs(outputs, inputs)
+
+
+def check_goldens(jobs: list[Job], manifest: str) -> None:
+    """Before ``--update-goldens`` runs anything: refuse a golden (or its record) that would
+    be written outside its manifest's folder (symbolic links followed), onto any input of the
+    run, or that two jobs would both write."""
+    inputs = [("manifest", manifest)]
+    for job in jobs:
+        inputs += [(f"mesh of job {job['name']!r}", job["mesh"]),
+                   (f"handle file of job {job['name']!r}", job["handles"]),
+                   *((f"file named by job {job['name']!r}'s handles", path)
+                     for path in referenced_files(job["handles"]))]
+    owners: dict[str, str] = {}
+    for job in jobs:
+        if not job["expect"]:
+            continue
+        golden = job["expect"].golden
+        refuse_leading_out(golden, job["golden_root"], f"job {job['name']!r}: golden ")
+        other = owners.setdefault(os.path.realpath(golden), job["name"])
+        if other != job["name"]:
+            raise InputError(f"job {job['name']!r}: golden {golden} is also job {other!r}'s: "
+                             "--update-goldens would write it twice")
+        refuse_overwriting_inputs([golden, record_path(golden)], inputs)
 
 
 def _stay_inside(jobs, out_dir):

@@ -8,7 +8,9 @@ from ...runtime.signals import Terminated
 from ..deform import DeformJob, JobResult, JobStatus, recorded_result, sidecar_path
 from .worker_pool import death_note
 
-#: a job of a manifest: name, absolute paths, output, settings, expect
+#: a job of a manifest: name, absolute paths, output, settings, expect (an Expect, or a
+#: mapping of its keys), golden_root, and what to do with goldens (``goldens``: see
+#: :data:`..deform.golden.GOLDEN_MODES`)
 Job = dict[str, Any]
 
 
@@ -32,7 +34,8 @@ def deform_job(job: Job, out_dir: str, keep_unconverged: bool = False) -> Deform
     return DeformJob(job["mesh"], job["handles"], os.path.join(out_dir, job["output"]),
                      settings=job["settings"], name=job["name"],
                      keep_unconverged=keep_unconverged, expect=job["expect"], record=True,
-                     inside=out_dir)
+                     inside=out_dir, goldens=job.get("goldens", "check"),
+                     golden_root=job.get("golden_root"))
 
 
 def interrupted_row(job: Job, out_dir: str | None = None, keep_unconverged: bool = False,

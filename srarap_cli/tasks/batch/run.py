@@ -9,7 +9,8 @@ A manifest (YAML or JSON) lists jobs; paths are relative to the manifest::
         handles: ../configs/bar-twist.yaml
         output: bar-twist.obj                           # relative to the output folder
         settings: {max_iter: 500}                       # this job only
-        expect: {golden: golden/bar-twist.obj, tol: 1.0e-9, relative: true}
+        expect: {golden: golden/bar-twist.obj, tol: 1.0e-9, relative: true,
+                 energy_rtol: 1.0e-6, max_iterations: 50}   # gates: see comparison.gates
 
 A job is up to date when its output exists and the sidecar ``<output>.srarap.json`` records
 the same fingerprint (content of the mesh, the handle file and every file it names, settings,
@@ -70,7 +71,7 @@ def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
         if golden is not None:
             found, expect = golden
             out_pictures["difference"] = encode_png(difference_picture(
-                mesh, deformed, found.of_b(len(deformed.vertices)), expect["tol"],
+                mesh, deformed, found.of_b(len(deformed.vertices)), expect.tol,
                 found.scale))
         if seen.get("log"):
             out_pictures["energy"] = encode_png(energy_picture(seen["log"]))

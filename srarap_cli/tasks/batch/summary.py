@@ -1,5 +1,5 @@
 """A batch's account of its jobs: ``summary.csv`` and ``summary.json`` in the output folder,
-and the HTML report and JUnit file where asked."""
+and the HTML report, JUnit, the Markdown summary and the OpenMetrics file where asked."""
 import csv
 import io
 import json
@@ -7,6 +7,7 @@ import os
 
 from ...runtime.commit import commit_files
 from ...runtime.encoding import utf8
+from ..ci_summaries import openmetrics, summary_markdown
 from ..job_status import SUMMARY_FIELDS, WARNING_JOIN, JobResult
 from ..reports import junit_xml, report_html
 from .manifest import SUMMARIES
@@ -22,10 +23,16 @@ def write_summaries(rows: list[JobResult], out: str) -> None:
 
 
 def write_reports(rows: list[JobResult], manifest: str, report: str | None,
-                  junit: str | None) -> None:
-    """The HTML report and the JUnit file, committed together."""
+                  junit: str | None, markdown: str | None = None,
+                  metrics: str | None = None) -> None:
+    """The HTML report, the JUnit file, the Markdown summary and the OpenMetrics file, those
+    asked for, committed together."""
     title = os.path.splitext(os.path.basename(manifest))[0]
     files = []
+    if markdown is not None:
+        files.append((markdown, utf8(summary_markdown(rows, f"srarap batch {title}"))))
+    if metrics is not None:
+        files.append((metrics, utf8(openmetrics(rows))))
     if report is not None:
         pictures = {r.job: r.pictures for r in rows}
         files.append((report, utf8(report_html(rows, pictures, f"srarap batch: {title}"))))

@@ -1,6 +1,8 @@
-"""``srarap compare`` as a job a Python caller can run too: two mesh files compared, the
-figures written as JSON, an HTML report and JUnit, and the verdict's exit code."""
+"""``srarap compare`` as a job a Python caller can run too: two mesh files compared against
+every gate asked for, the figures written as JSON, an HTML report, JUnit, a Markdown summary
+and OpenMetrics, the golden (B) created or updated where asked, and the verdict's exit code."""
 import json
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -9,19 +11,28 @@ from ...io.mesh.mesh import Mesh
 from ...runtime import exit_codes
 from ...runtime.commit import commit_files
 from ...runtime.encoding import utf8
-from ...runtime.errors import UsageProblem
+from ...runtime.errors import InputError, UsageProblem
+from ..ci_summaries import openmetrics, summary_markdown
 from ..job_status import JobResult, JobStatus
 from ..pictures import difference_picture, shape_picture
 from ..preflight import check_output_path, read_any_mesh, refuse_overwrite
 from ..reports import encode_png, junit_xml, report_html
+from .align import moved
 from .compare import Comparison, Verdict, compare_meshes
+from .gates import Expect, Observed, judge, verdict_line
+from .goldens import write_golden
 
 
 @dataclass(frozen=True)
 class CompareJob:
-    """Meshes ``a`` and ``b`` (paths; one may be ``-``) within ``tol`` (a fraction of A's
-    diagonal with ``relative``), and the files to write: ``json``, ``report`` (HTML),
-    ``junit``."""
+    """Meshes ``a`` (obtained) and ``b`` (the golden; paths, one may be ``-``) within
+    ``tol`` (a fraction of A's diagonal with ``relative``), and the files to write: ``json``,
+    ``report`` (HTML), ``junit``, ``summary_md`` (Markdown), ``metrics`` (OpenMetrics).
+
+    ``beyond_tol``, ``p95``, ``p99``: the other distance gates (see
+    :class:`~.gates.Expect`); ``align``: ``rigid`` moves B onto A first; ``goldens``:
+    ``update`` writes A to B when B is missing or beyond the gates (the exit code still says
+    so), ``accept`` too and exits 0."""
 
     a: str
     b: str
@@ -31,79 +42,159 @@ class CompareJob:
     report: str | None = None
     junit: str | None = None
     input_format: MeshFormat | None = None
+    beyond_tol: float = 0.0
+    p95: float | None = None
+    p99: float | None = None
+    align: str = "none"
+    goldens: str = "check"
+    summary_md: str | None = None
+    metrics: str | None = None
+
+    def expect(self) -> Expect:
+        return Expect(self.b, self.tol, self.relative, self.beyond_tol, self.p95, self.p99,
+                      align=self.align)
 
 
 @dataclass(frozen=True)
 class CompareOutcome:
-    """The comparison (in the job's unit), its verdict, the exit code (0 within, 7 not)."""
+    """The comparison (in the job's unit; None when B was missing and written), its verdict,
+    the gates that failed, what became of B (``golden``: ``created``, ``updated`` or ""), and
+    the exit code: 0 within, 7 beyond, 8 B missing (written with ``update``); 0 whenever
+    ``accept`` wrote B."""
 
     job: CompareJob
-    found: Comparison
+    found: Comparison | None
     verdict: Verdict
+    failed: tuple[str, ...] = ()
+    golden: str = ""
 
     @property
     def exit_code(self) -> int:
-        return exit_codes.OK if self.verdict.within else exit_codes.BEYOND_TOLERANCE
+        if self.golden and self.job.goldens == "accept" or not self.failed:
+            return exit_codes.OK
+        return exit_codes.BATCH_FAILED if self.found is None else exit_codes.BEYOND_TOLERANCE
 
     @property
     def warnings(self) -> list[str]:
         return []
 
+    @property
+    def status(self) -> JobStatus:
+        if self.exit_code == exit_codes.OK:
+            return JobStatus.OK
+        return JobStatus.NO_GOLDEN if self.found is None else JobStatus.REGRESSED
+
     def figures(self) -> dict[str, Any]:
         """What ``--json`` writes."""
-        return {"a": self.job.a, "b": self.job.b, "mode": self.found.mode,
+        found = {} if self.found is None else self.found.figures()
+        return {"a": self.job.a, "b": self.job.b, "mode": found.get("mode"),
                 "relative": self.job.relative, "tol": self.job.tol,
-                "within_tol": self.verdict.within, "max": self.found.max,
-                "mean": self.found.mean, "rms": self.found.rms,
-                "diagonal": self.found.diagonal, "farthest": self.found.farthest,
-                "beyond_tol": self.verdict.beyond}
-
-    def where(self) -> str:
-        """Where the largest difference is, when it is beyond the tolerance."""
-        far = self.found.farthest
-        if self.verdict.within or far is None or "position" not in far:
-            return ""
-        at = ", ".join(f"{x:.4g}" for x in far["position"])
-        return (f"; farthest: {far['mesh'].upper()}'s vertex {far['vertex']} at ({at}); "
-                f"{100 * self.verdict.beyond:.3g}% of the vertices beyond tol")
+                "within_tol": not self.failed, "max": found.get("max"),
+                "mean": found.get("mean"), "rms": found.get("rms"),
+                "diagonal": found.get("diagonal"), "farthest": found.get("farthest"),
+                "beyond_tol": self.verdict.beyond, "status": self.status.value,
+                "failed": list(self.failed), "golden": self.golden or None,
+                **{k: v for k, v in found.items() if k not in _IN_FRONT}}
 
     def summary(self) -> str:
         unit = " of the diagonal" if self.job.relative else ""
-        return (f"srarap compare: {'within' if self.verdict.within else 'BEYOND'} tol "
-                f"{self.job.tol:g}{unit} ({self.found.mode}): max {self.found.max:.6g}, mean "
-                f"{self.found.mean:.6g}, rms {self.found.rms:.6g}{unit}{self.where()}")
+        written = f"; B {self.golden} from A" if self.golden else ""
+        if self.found is None:
+            return f"srarap compare: no golden at {self.job.b}{written}"
+        line = verdict_line(self.found, self.job.expect(), list(self.failed), unit)
+        return f"srarap compare: {line}{written}"
+
+
+_IN_FRONT = ("mode", "max", "mean", "rms", "diagonal", "farthest")
 
 
 def run_compare(job: CompareJob) -> CompareOutcome:
-    """Compare ``job``'s meshes and commit the files it asks for (all or none)."""
+    """Compare ``job``'s meshes, write B from A where ``job.goldens`` says so, and commit the
+    files it asks for (all or none)."""
+    _check(job)
+    ma = read_any_mesh(job.a, job.input_format)[0]
+    if job.goldens != "check" and job.b != "-" and not os.path.exists(job.b):
+        golden = write_golden(job.b, ma, Observed(), _root(job.b), _file(job.a))
+        done = CompareOutcome(job, None, Verdict(job.tol, False, 1.0),
+                              (f"no golden at {job.b}",), golden)
+        _commit(job, done, ma, None)
+        return done
+    if job.goldens == "check" and job.b != "-" and not os.path.lexists(job.b):
+        raise InputError(f"{job.b}: no such file (a golden not made yet? srarap compare A B "
+                         "--update writes A there)")
+    mb = read_any_mesh(job.b, job.input_format)[0]
+    found = compare_meshes(ma, mb, job.align).scaled(job.relative)
+    unit = " of the diagonal" if job.relative else ""
+    failed = tuple(judge(found, job.expect(), Observed(), None, unit, "A", "B"))
+    golden = ""
+    if failed and job.goldens != "check":
+        golden = write_golden(job.b, ma, Observed(), _root(job.b), _file(job.a))
+    done = CompareOutcome(job, found, found.verdict(job.tol), failed, golden)
+    _commit(job, done, ma, mb if found.motion is None else moved(mb, found.motion))
+    return done
+
+
+def _check(job):
     for path, ext, what in ((job.json, (".json",), "--json"),
                             (job.report, (".html", ".htm"), "--report"),
-                            (job.junit, (".xml",), "--junit")):
+                            (job.junit, (".xml",), "--junit"),
+                            (job.summary_md, None, "--summary-md"),
+                            (job.metrics, None, "--metrics")):
         if path is not None:
             check_output_path(path, ext, what)
-    refuse_overwrite([job.json, job.report, job.junit],
+    refuse_overwrite([job.json, job.report, job.junit, job.summary_md, job.metrics],
                      others=[("mesh A", job.a), ("mesh B", job.b)])
     if job.a == job.b == "-":
         raise UsageProblem("only one of A and B can be '-' (standard input)")
-    ma, mb = read_any_mesh(job.a, job.input_format)[0], read_any_mesh(job.b, job.input_format)[0]
-    found = compare_meshes(ma, mb).scaled(job.relative)
-    done = CompareOutcome(job, found, found.verdict(job.tol))
+    if job.goldens != "check":
+        if job.b == "-":
+            raise UsageProblem("--update writes B: B cannot be '-' (standard input)")
+        if os.path.exists(job.a) and os.path.exists(job.b) \
+                and os.path.samefile(job.a, job.b):
+            raise InputError(f"{job.b}: is mesh A; refusing to overwrite an input")
+
+
+def _file(path):
+    """A's file, whose bytes become B's where both have one extension (not a stream)."""
+    return None if path == "-" or not os.path.isfile(path) else path
+
+
+def _root(golden):
+    """The folder a golden named on the command line may be written in: its own."""
+    return os.path.dirname(os.path.abspath(golden))
+
+
+def _commit(job, done, ma, mb):
     files = [] if job.json is None else [(job.json, utf8(json.dumps(done.figures(), indent=2)
                                                           + "\n"))]
-    if job.report is not None or job.junit is not None:
-        within = done.verdict.within
-        status = JobStatus.OK if within else JobStatus.REGRESSED
-        row = JobResult(f"{job.a} vs {job.b}", status, status.exit_code, compare_max=found.max,
-                        compare_mean=found.mean, tol=job.tol, message="" if within else
-                        f"max distance {found.max:.3g} > tol {job.tol:g}{done.where()}")
+    if any(p is not None for p in (job.report, job.junit, job.summary_md, job.metrics)):
+        row = _row(job, done)
         if job.report is not None:
-            pictures = compare_pictures(ma, mb, found, job.tol)
+            pictures = {} if mb is None else compare_pictures(ma, mb, done.found, job.tol)
             files.append((job.report, utf8(report_html([row], {row.job: pictures},
                                                        "srarap compare"))))
         if job.junit is not None:
             files.append((job.junit, utf8(junit_xml([row], "compare"))))
+        if job.summary_md is not None:
+            files.append((job.summary_md, utf8(summary_markdown([row], "srarap compare"))))
+        if job.metrics is not None:
+            files.append((job.metrics, utf8(openmetrics([row]))))
     commit_files(files)
-    return done
+
+
+def _row(job, done):
+    """The comparison as one job's row, for the report, JUnit and the summaries."""
+    found, status = done.found, done.status
+    message = "; ".join(done.failed)
+    if done.golden:
+        message = f"B {done.golden} from A" + (f": {message}" if message else "")
+    row = JobResult(f"{job.a} vs {job.b}", status, done.exit_code, tol=job.tol,
+                    message=message, golden=done.golden)
+    if found is not None:
+        row.compare_max, row.compare_mean = found.max, found.mean
+        row.compare_p95, row.compare_p99 = found.p95, found.p99
+        row.beyond_tol = done.verdict.beyond
+    return row
 
 
 def compare_pictures(a: Mesh, b: Mesh, found: Comparison, tol: float) -> dict[str, str]:

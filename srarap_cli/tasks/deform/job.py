@@ -24,6 +24,7 @@ from ...runtime.limits import check_solve
 from ...runtime.stages import ended as stage_ended
 from ...solver.settings import resolve
 from ...solver.stop import StopReason
+from ..comparison import Expect
 from ..distortion import vertex_distortion
 from ..info import up_axis
 from ..job_status import JobResult, JobStatus
@@ -54,7 +55,12 @@ class DeformJob:
     keep_unconverged : bool, write the mesh of a solve that did not converge
     cache : str, optional, folder of simplified meshes (multiresolution)
     fps, frame : the pose of keyframed groups
-    expect : mapping, optional, ``golden`` (path), ``tol``, ``relative``: compare with it
+    expect : Expect or mapping, optional, the golden (path) and the gates it must pass (see
+        :class:`~srarap_cli.tasks.comparison.gates.Expect`): compare with it
+    goldens : {"check", "update", "accept"}, what to do with a missing or regressed golden
+        (see :data:`.golden.GOLDEN_MODES`)
+    golden_root : str, optional, the folder goldens may be written in (a batch: the
+        manifest's)
     record : bool, keep a record beside the output and take an unchanged job's result from
         it without solving (batches)
     inside : str, optional, a folder every file the job writes must stay in, symbolic links
@@ -77,7 +83,9 @@ class DeformJob:
     cache: str | None = None
     fps: float | None = None
     frame: float = 0.0
-    expect: Mapping[str, Any] | None = None
+    expect: Expect | Mapping[str, Any] | None = None
+    goldens: str = "check"
+    golden_root: str | None = None
     record: bool = False
     inside: str | None = None
 
@@ -101,7 +109,8 @@ def run_job(job: DeformJob, callback: Callable[[dict], None] | None = None,
         result = _solve(job, fmt, callback, write_stdout, key, on_warnings)
     if job.expect is not None and result.status is not JobStatus.NOT_CONVERGED \
             and os.path.exists(job.output):
-        check_golden(result, job.expect, job.output)
+        result.seconds = time.perf_counter() - start  # what a seconds gate judges
+        check_golden(result, job.expect, job.output, job.goldens, job.golden_root)
     result.seconds = time.perf_counter() - start
     return result
 
@@ -180,12 +189,14 @@ def recorded_result(job: DeformJob, key: str | None = None) -> JobResult | None:
                      stop=rec["stop"] or "", iterations=rec["iterations"],
                      energy=rec["energy"], solved=False,
                      message="" if status is JobStatus.UP_TO_DATE
-                     else "inputs unchanged since the recorded run")
+                     else "inputs unchanged since the recorded run",
+                     seen={"recorded_seconds": rec["seconds"]})
 
 
 def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
     peaks: dict[str, int | None] = {}
     peak, mark = memory.start(), time.perf_counter()
+    started = mark
     source, source_format = read_any_mesh(job.mesh, job.input_format)
     peaks["read"] = memory.stop(peak)
     stage_ended("read", time.perf_counter() - mark)
@@ -213,7 +224,7 @@ def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
     if key is not None:
         files.append((sidecar_path(job.output), record_bytes(
             key, status.value, solve.iterations, solve.energy, solve.stop_reason.value,
-            notes + lost)))
+            notes + lost, time.perf_counter() - started)))
     if keep and job.output == "-" and write_stdout is not None:
         write_stdout(mesh_bytes)  # first: the files are committed only once it was written
     commit_files(files, inside=job.inside)

@@ -14,7 +14,7 @@ from ...solver.stop import StopReason
 from ..deciding import deciding
 
 #: what a record keeps of a job's result
-RECORDED = ("status", "iterations", "energy", "stop", "warnings")
+RECORDED = ("status", "iterations", "energy", "stop", "warnings", "seconds")
 
 
 def sidecar_path(output: str) -> str:
@@ -64,11 +64,13 @@ def _well_formed(rec: dict[str, Any]) -> bool:
     warnings = rec.get("warnings", [])
     return (rec.get("status") in STATUSES and rec.get("stop", "") in STOPS
             and number(rec.get("iterations"), int) and number(rec.get("energy"), (int, float))
+            and number(rec.get("seconds"), (int, float))
             and isinstance(warnings, list) and all(isinstance(w, str) for w in warnings))
 
 
 def record_bytes(key: str, status: str, iterations: int | None, energy: float | None,
-                 stop: str, warnings: Sequence[str]) -> bytes:
-    """The record's file content."""
+                 stop: str, warnings: Sequence[str], seconds: float | None = None) -> bytes:
+    """The record's file content (``seconds``: the solve's, for a seconds gate on a rerun)."""
     return json.dumps({"fingerprint": key, "iterations": iterations, "energy": energy,
-                       "status": status, "stop": stop, "warnings": list(warnings)}).encode()
+                       "status": status, "stop": stop, "warnings": list(warnings),
+                       "seconds": seconds}).encode()
