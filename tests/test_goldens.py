@@ -230,3 +230,32 @@ def test_every_gate_is_documented_and_runs_from_a_manifest_the_fixture_and_compa
     python = run_compare(CompareJob(golden, golden,
                                     **{k: GATE_VALUES[k] for k in COMPARE_OPTIONS}))
     assert python.exit_code == 0
+
+
+def test_a_golden_of_another_frame_or_mesh_says_how_far_each_way_in_every_output(project):
+    """A golden moved rigidly passes with ``align: rigid`` and the motion is said; a golden
+    that does not share the output's vertices (another job's shape with one stray vertex
+    more) reports both one-sided distances in the summary, the card and JUnit."""
+    import numpy as np
+
+    from srarap_cli.io.mesh import Mesh, read_mesh, write_mesh
+    batch(project, "--accept-goldens")
+    made = read_mesh(str(project / "golden" / "twist.obj"))
+    turn = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]])
+    write_mesh(str(project / "golden" / "twist.obj"), made.with_vertices(made.vertices @ turn.T + 5))
+    V, F = made.vertices, made.triangles()[0]
+    write_mesh(str(project / "golden" / "bend.obj"),
+               Mesh.from_arrays(np.vstack([V, [[0.0, 0, 100]]]), F))  # one stray vertex more
+    manifest = yaml.safe_load((project / "jobs.yaml").read_text())
+    manifest["jobs"][0]["expect"]["align"] = "rigid"
+    (project / "jobs.yaml").write_text(yaml.safe_dump(manifest))
+    r, rows = batch(project)
+    assert rows["twist"]["status"] == "up-to-date", rows["twist"]["message"]
+    assert rows["twist"]["aligned"].startswith("turned 90 degrees about (0, 0, 1), moved by (5, 5, 5)")
+    bend = rows["bend"]
+    assert bend["status"] == "regressed" and float(bend["compare_a_to_b"]) > 0
+    assert float(bend["compare_b_to_a"]) >= 0 and bend["compare_a_to_b"] != bend["compare_b_to_a"]
+    message = junit_cases(project)["bend"].find("failure").get("message")
+    assert "one-sided: A to B max" in message
+    html = (project / "out" / "r.html").read_text()
+    assert "<th>A to B</th>" in html and "aligned first: turned 90 degrees" in html

@@ -10,11 +10,14 @@ from ..runtime import exit_codes
 #: the columns of a batch's ``summary.csv`` (``summary.json`` holds ``warnings`` as a list;
 #: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason`, empty for a job that
 #: never reached the solver)
-#: ``compare_*``, ``beyond_tol``: the distances to the golden (the unit of ``tol``);
-#: ``golden``: ``created`` or ``updated`` where ``--update-goldens`` wrote it)
+#: ``compare_*``, ``beyond_tol``: the distances to the golden (the unit of ``tol``;
+#: ``compare_a_to_b`` / ``compare_b_to_a``: the largest one-sided distances, golden to output
+#: and back, where the meshes do not share vertices); ``aligned``: the rigid motion applied
+#: first (``align: rigid``); ``golden``: ``created`` or ``updated`` where the run wrote it)
 SUMMARY_FIELDS = ("job", "status", "stop", "iterations", "energy", "seconds", "compare_max",
                   "message", "compare_mean", "tol", "exit_code", "compare_p95", "compare_p99",
-                  "beyond_tol", "golden", "warnings")
+                  "beyond_tol", "compare_a_to_b", "compare_b_to_a", "aligned", "golden",
+                  "warnings")
 #: how warnings are joined in one CSV cell
 WARNING_JOIN = " | "
 
@@ -85,7 +88,10 @@ class JobResult:
     seconds : float, the job's wall time
     compare_max, compare_mean, compare_p95, compare_p99 : distances to the golden mesh, in
         the unit of ``tol``
+    compare_a_to_b, compare_b_to_a : the largest one-sided distances (A the golden), where
+        the meshes do not share vertices
     tol : the tolerance; beyond_tol : the fraction of vertices beyond it
+    aligned : the rigid motion the result was moved by first, in words, or ""
     golden : ``created`` or ``updated`` where this run wrote the golden, else ""
     solved : bool, the solver ran in this run (False: an unchanged job's recorded result)
     written : str, the output mesh written, or None
@@ -111,6 +117,9 @@ class JobResult:
     compare_p95: float | None = None
     compare_p99: float | None = None
     beyond_tol: float | None = None
+    compare_a_to_b: float | None = None
+    compare_b_to_a: float | None = None
+    aligned: str = ""
     golden: str = ""
     solved: bool = False
     written: str | None = None
@@ -128,7 +137,8 @@ class JobResult:
                 "compare_mean": self.compare_mean, "tol": self.tol, "exit_code": self.exit_code,
                 "warnings": list(self.warnings), "compare_p95": self.compare_p95,
                 "compare_p99": self.compare_p99, "beyond_tol": self.beyond_tol,
-                "golden": self.golden}
+                "compare_a_to_b": self.compare_a_to_b, "compare_b_to_a": self.compare_b_to_a,
+                "aligned": self.aligned, "golden": self.golden}
 
     def shipped(self) -> "JobResult":
         """This result without what stays in the process that ran it (the solve's arrays),

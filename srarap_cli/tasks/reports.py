@@ -82,6 +82,9 @@ def _job(row, pictures):
                ("p95", _number(row.compare_p95, ".3g")),
                ("p99", _number(row.compare_p99, ".3g")),
                ("beyond tol", "-" if row.beyond_tol is None else f"{100 * row.beyond_tol:.3g}%"),
+               *([("A to B", _number(row.compare_a_to_b, ".3g")),  # A: the golden
+                  ("B to A", _number(row.compare_b_to_a, ".3g"))]
+                 if row.compare_a_to_b is not None else []),
                ("tolerance", _number(row.tol, "g")),
                ("golden", html.escape(row.golden or "-")),
                ("warnings", str(len(row.warnings)))]
@@ -92,7 +95,8 @@ def _job(row, pictures):
         f"{pictures[key]}\"><figcaption>{html.escape(caption)}</figcaption></figure>"
         for key, caption in PICTURES if key in pictures)
     message = "".join(f"<p class=\"message\">{html.escape(text)}</p>"
-                      for text in (row.message, pictures.get("note")) if text)
+                      for text in (row.message, row.aligned and f"aligned first: {row.aligned}",
+                                   pictures.get("note")) if text)
     warnings = ("<ul class=\"warnings\">" + "".join(
         f"<li>warning: {html.escape(w)}</li>" for w in row.warnings) + "</ul>"
         if row.warnings else "")
@@ -199,6 +203,11 @@ def _detail(row):
                      f"{_number(row.compare_mean, '.3g')}, p95 {_number(row.compare_p95, '.3g')}"
                      f", p99 {_number(row.compare_p99, '.3g')}, beyond tol {beyond}, tol "
                      f"{_number(row.tol, 'g')}")
+    if row.compare_a_to_b is not None:
+        parts.append(f"one-sided: A to B max {row.compare_a_to_b:.3g}, B to A max "
+                     f"{_number(row.compare_b_to_a, '.3g')} (at every vertex)")
+    if row.aligned:
+        parts.append(f"aligned first: {row.aligned}")
     if row.golden:
         parts.append(f"golden {row.golden} by this run")
     if row.warnings:

@@ -95,6 +95,16 @@ class Comparison:
         """(n_b,) model-unit distances of B's vertices (a difference picture colours B)."""
         return self.distances if self.mode == "per-vertex" else self.distances[-n_b:]
 
+    def row_figures(self, tol: float) -> dict[str, Any]:
+        """The figures a job's result row keeps (:class:`~..job_status.JobResult`'s
+        ``compare_*``, ``beyond_tol`` and ``aligned``), against ``tol``."""
+        sides = self.one_sided or {}
+        return {"compare_max": self.max, "compare_mean": self.mean, "compare_p95": self.p95,
+                "compare_p99": self.p99, "beyond_tol": self.verdict(tol).beyond,
+                "compare_a_to_b": sides.get("a_to_b", {}).get("max"),
+                "compare_b_to_a": sides.get("b_to_a", {}).get("max"),
+                "aligned": "" if self.motion is None else motion_text(self.motion)}
+
     def figures(self) -> dict[str, Any]:
         """The distances as ``--json`` and the summaries write them (the comparison's unit)."""
         out: dict[str, Any] = {"mode": self.mode, "max": self.max, "mean": self.mean,
@@ -108,6 +118,21 @@ class Comparison:
 
 
 _FIGURES = ("max", "mean", "rms", "p95", "p99")
+
+
+def motion_text(motion: dict[str, Any]) -> str:
+    """A rigid motion in words, rounding off below 1e-12 (``-7e-17`` is 0).
+
+    Examples
+    --------
+    >>> motion_text({"angle": 30.0, "axis": [1, -7e-17, 0], "translation": [3, 0, 1e-20]})
+    'turned 30 degrees about (1, 0, 0), moved by (3, 0, 0)'
+    """
+    def text(values, digits):
+        return ", ".join(format(x if abs(x) > 1e-12 else 0.0, digits) for x in values)
+
+    return (f"turned {motion['angle']:.4g} degrees about ({text(motion['axis'], '.3g')}), "
+            f"moved by ({text(motion['translation'], '.4g')})")
 
 
 def compare_meshes(a: Mesh | tuple, b: Mesh | tuple, align: str = "none") -> Comparison:

@@ -11,7 +11,7 @@ from typing import Any
 
 from ...runtime.errors import excerpt, unknown_key
 from ...runtime.numbers import spelled, whole
-from .compare import ALIGNMENTS, Comparison
+from .compare import ALIGNMENTS, Comparison, motion_text
 
 
 @dataclass(frozen=True)
@@ -244,10 +244,7 @@ def verdict_line(found: Comparison, expect: Expect, failed: list[str], unit: str
         text += (f"; {names[0]} to {names[1]}: max {ab['max']:.3g}, {names[1]} to {names[0]}: "
                  f"max {ba['max']:.3g} (at every vertex)")
     if found.motion is not None:
-        m = found.motion
-        text += (f"; {names[1]} aligned first: turned {m['angle']:.4g} degrees about "
-                 f"({', '.join(f'{x:.3g}' for x in m['axis'])}), moved by "
-                 f"({', '.join(f'{x:.4g}' for x in m['translation'])})")
+        text += f"; {names[1]} aligned first: {motion_text(found.motion)}"
     return text
 
 

@@ -191,9 +191,8 @@ def _row(job, done):
     row = JobResult(f"{job.a} vs {job.b}", status, done.exit_code, tol=job.tol,
                     message=message, golden=done.golden)
     if found is not None:
-        row.compare_max, row.compare_mean = found.max, found.mean
-        row.compare_p95, row.compare_p99 = found.p95, found.p99
-        row.beyond_tol = done.verdict.beyond
+        for name, value in found.row_figures(job.tol).items():
+            setattr(row, name, value)
     return row
 
 

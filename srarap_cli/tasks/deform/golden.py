@@ -31,8 +31,8 @@ def as_expect(expect: Expect | Mapping[str, Any]) -> Expect:
 def check_golden(result: JobResult, expect: Expect | Mapping[str, Any], out: str,
                  goldens: str = "check", root: str | None = None) -> None:
     """Compare the mesh ``out`` with ``expect``'s golden into ``result``: the distances
-    (``compare_max``, ``compare_mean``, ``compare_p95``, ``compare_p99``, ``beyond_tol``, in
-    the unit of ``tol``: a fraction of the golden mesh's diagonal with ``relative``), status
+    (``compare_*`` and ``beyond_tol``, in the unit of ``tol``: a fraction of the golden
+    mesh's diagonal with ``relative``; ``aligned``: the rigid motion applied first), status
     ``regressed`` with every failing gate in the message, or ``no-golden`` when the golden is
     missing; the figures are kept in ``result.seen["golden"]`` for the report's difference
     picture. With ``goldens`` ``update`` or ``accept`` (see :data:`GOLDEN_MODES`) a missing
@@ -56,9 +56,8 @@ def check_golden(result: JobResult, expect: Expect | Mapping[str, Any], out: str
 def _measure(result, expect, out, run):
     found = compare_meshes(read_mesh(expect.golden), read_mesh(out),
                            expect.align).scaled(expect.relative)
-    result.compare_max, result.compare_mean = found.max, found.mean
-    result.compare_p95, result.compare_p99 = found.p95, found.p99
-    result.beyond_tol = found.verdict(expect.tol).beyond
+    for name, value in found.row_figures(expect.tol).items():
+        setattr(result, name, value)
     result.seen["golden"] = (found, expect)
     record = read_golden_record(expect.golden) if expect.needs_record else None
     unit = " (fractions of the golden mesh's diagonal)" if found.relative else ""
