@@ -182,6 +182,9 @@ def test_every_code_reaches_the_user_with_its_code(tmp_path):
         seen |= _deform(grid, _yaml(h, doc), tmp_path)
     seen |= _deform(grid, _yaml(h, _bend()), tmp_path, "--weights", "cotan")
     seen |= _deform(grid, _yaml(h, _bend()), tmp_path, "--multires", "1000")
+    seen |= _deform(grid, _yaml(h, {"groups": {"fix": {**EDGE, "fixed": True}}}), tmp_path)
+    every = {"box": {"min": [-1, -1, -1], "max": [2, 2, 1]}, "translate": [0, 0, 0.1]}
+    seen |= _deform(grid, _yaml(h, {"groups": {"all": every}}), tmp_path)
     parts = _two_parts(tmp_path)
     doc = {"groups": {"fix": {**EDGE, "fixed": True},
                       "carry": {"box": {"min": [2.9, -1, -1], "max": [4.1, 2, 1]},

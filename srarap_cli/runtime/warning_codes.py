@@ -53,7 +53,12 @@ CODES = {c.name: c for c in (
     Code("not-rigid", REQUEST, "a matrix no rigid motion reaches (it mirrors, scales or "
                                "shears)"),
     Code("rigid-part", REQUEST, "a connected part held only by handles that move it rigidly: "
-                                "it moves as one piece"),
+                                "it moves as one piece (the whole mesh, when it is one part: "
+                                "a fixed group forgotten?)"),
+    Code("no-motion", REQUEST, "every handle keeps its rest position (only fixed groups): the "
+                               "result is the rest shape"),
+    Code("all-held", REQUEST, "every vertex is constrained: the result is the targets, "
+                              "nothing is solved"),
     Code("part-at-rest", REQUEST, "a connected part without a constrained vertex: kept at "
                                   "rest"),
     Code("unreached-keys", REQUEST, "keyframes after an animation's last frame"),

@@ -22,6 +22,7 @@ from ..solver.region import restrict
 from ..solver.result import DeformResult
 from ..solver.settings import STAGES, Settings, resolve, with_keywords
 from .rigid_parts import rigid_part_warnings
+from .still_requests import still_request_warnings
 
 
 @dataclass
@@ -92,11 +93,13 @@ def _labels(constraints, full_ids):
 def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = None,
                    handle_warnings: Sequence[str] = (),
                    constraints: Constraints | None = None,
-                   on_warnings: Callable[[list[str]], None] | None = None
-                   ) -> tuple[Solver, list[str]]:
+                   on_warnings: Callable[[list[str]], None] | None = None,
+                   still: bool = True) -> tuple[Solver, list[str]]:
     """The solver of ``p`` for a command (deform, animate) and the warnings of the handle
     file (``handle_warnings``), the mesh, the solver and, given ``constraints``, the parts
-    they carry off rigidly (:mod:`.rigid_parts`); under ``opts.strict`` the first
+    they carry off rigidly (:mod:`.rigid_parts`) or that ask for nothing to move (unless
+    ``still`` is False, as for an animation, whose first frame is usually the rest pose:
+    :func:`request_warnings`); under ``opts.strict`` the first
     warning is raised instead (before the solver is built, where it can be). The mesh checks
     run before the solver is built, so their temporaries (edge tables of the whole mesh) do
     not add to the memory it holds (2M-vertex bar: peak 11.4 -> 10.6 GiB); the process's
@@ -108,7 +111,7 @@ def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = N
     mark = time.perf_counter()
     notes = list(handle_warnings) + mesh_warnings(mesh.vertices, mesh.triangles()[0])
     if constraints is not None:
-        notes += request_warnings(mesh, p, constraints)
+        notes += request_warnings(mesh, p, constraints, still)
     stage_ended("checks", time.perf_counter() - mark)
     if failing(notes, opts.strict, opts.allow):  # with what the setup would say: all at once
         refuse_warnings(opts, notes + model_warnings(p, opts))
@@ -126,9 +129,15 @@ def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = N
     return deformer, notes
 
 
-def request_warnings(mesh: Mesh, p: Problem, constraints: Constraints) -> list[str]:
-    """What the handles ask that deserves a word before a solve: connected parts they carry
-    off rigidly (:mod:`.rigid_parts`). ``srarap info`` says the same."""
+def request_warnings(mesh: Mesh, p: Problem, constraints: Constraints,
+                     still: bool = True) -> list[str]:
+    """What the handles ask that deserves a word before a solve: nothing to deform (every
+    vertex held, every handle at rest: :mod:`.still_requests`, unless ``still`` is False: an
+    animation's first frame is usually its rest pose) or connected parts they carry off
+    rigidly (:mod:`.rigid_parts`). ``srarap info`` says the same."""
+    said = still_request_warnings(mesh.vertices, constraints) if still else []
+    if said:
+        return said
     return rigid_part_warnings(mesh.vertices, p.F if p.sub is None else
                                solvable_faces(mesh.triangles()[0]), constraints)
 

@@ -1,7 +1,8 @@
 """Connected parts that handles carry off as rigid pieces: a part held only by handles whose
 targets are one rigid motion of their rest positions (a teapot's spout held by the moving
-group alone) moves as one piece, apart from the rest of the mesh. The solve then converges in
-one iteration at zero energy, which reads as an excellent result: say what happened."""
+group alone; a whole mesh whose fixed group was forgotten) moves as one piece. The solve then
+converges in one iteration at zero energy, which reads as an excellent result: say what
+happened."""
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse import csgraph
@@ -12,8 +13,9 @@ from ..runtime.warning_codes import note
 
 
 def rigid_part_warnings(V: np.ndarray, F: np.ndarray, constraints: Constraints) -> list[str]:
-    """One warning naming the groups and the parts' sizes when, in a mesh of several
-    connected parts, some part is held only by handles that move it rigidly (not at rest).
+    """One warning naming the groups and the parts' sizes when some connected part is held
+    only by handles that move it rigidly (not at rest): the whole mesh, when that is every
+    part the handles hold.
 
     Parameters
     ----------
@@ -26,8 +28,11 @@ def rigid_part_warnings(V: np.ndarray, F: np.ndarray, constraints: Constraints) 
     >>> F = np.array([[0, 1, 2], [3, 4, 5]])
     >>> c = Constraints(ids=np.array([0, 3, 4]), targets=V[[0, 3, 4]] + [0, 0, 1],
     ...                 groups={"lift": np.array([0, 3, 4])})
-    >>> rigid_part_warnings(V, F, c)[0][:60]
-    '2 connected part(s) (6 vertices, the largest 3) are held onl'
+    >>> rigid_part_warnings(V, F, c)[0][:70]
+    'the whole mesh (2 connected parts, 6 vertices) is held only by handles'
+    >>> rigid_part_warnings(V[:3], F[:1], Constraints(ids=np.array([0]),
+    ...                     targets=V[[0]] + 1, groups={"trunk": np.array([0])}))[0][:80]
+    'the whole mesh (1 connected part, 3 vertices) is held only by handles that move '
     """
     n = len(V)
     if not len(F) or not len(constraints.ids):
@@ -35,8 +40,6 @@ def rigid_part_warnings(V: np.ndarray, F: np.ndarray, constraints: Constraints) 
     edges = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
     graph = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
     n_parts, label = csgraph.connected_components(graph, directed=False)
-    if n_parts < 2:
-        return []
     rigid = _rigidly_moved(V[constraints.ids], constraints.targets, label[constraints.ids],
                            n_parts, float(np.linalg.norm(np.ptp(V, axis=0))))
     if not rigid.any():
@@ -45,6 +48,12 @@ def rigid_part_warnings(V: np.ndarray, F: np.ndarray, constraints: Constraints) 
     held = np.isin(label, np.flatnonzero(rigid))
     names = [name for name, ids in constraints.groups.items() if held[np.asarray(ids)].any()]
     by = f" by group(s) {', '.join(map(repr, names))}" if names else ""
+    if held[constraints.ids].all():  # nothing the handles hold can bend
+        parts = f"{n_parts} connected part{'s' if n_parts > 1 else ''}"
+        return [note("rigid-part", f"the whole mesh ({parts}, {sizes.sum()} vertices) is held "
+                     f"only by handles that move it rigidly{by}: it moves as one piece, at no "
+                     "energy, and nothing bends (a fixed group forgotten? hold what should "
+                     "stay with one)")]
     return [note("rigid-part", f"{rigid.sum()} connected part(s) ({sizes.sum()} vertices, the "
                  f"largest {sizes.max()}) are held only by handles that move each rigidly{by}: "
                  "each moves as one piece, apart from the rest of the mesh, at no energy (hold "

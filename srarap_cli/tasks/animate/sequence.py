@@ -91,7 +91,7 @@ class Animator:
         #: warnings: what the mesh checks and the solver found (e.g. mesh problems)
         self.deformer, self.warnings = command_solver(mesh, self.problem, opts, cache,
                                                       [*known, *constraints.warnings],
-                                                      constraints, on_warnings)
+                                                      constraints, on_warnings, still=False)
         self.last_result: DeformResult | None = None
 
     def run(self, frames: int, *, max_iter: int | None = None, stop_unconverged: bool = False,
