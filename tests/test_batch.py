@@ -135,3 +135,30 @@ def test_editing_a_file_the_handle_file_names_makes_the_job_run_again(tmp_path):
     assert run(path, tmp_path / "out")[1]["m"]["status"] == "up-to-date"
     (tmp_path / "move.def").write_text("1 0 0 0.7\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
     assert run(path, tmp_path / "out")[1]["m"]["status"] == "ok"
+
+
+def test_changing_only_the_strictness_judges_the_record_again_without_solving(tmp_path):
+    """Issue 70: a rerun with only --strict/--allow changed solved every job again. The
+    strictness decides nothing in a mesh: the recorded warnings are judged again."""
+    h = tmp_path / "slip.yaml"  # a forgotten fixed group: a [rigid-part] warning
+    h.write_text(yaml.safe_dump({"groups": {"top": {
+        "box": {"min": [-2, -2, 9.99], "max": [2, 2, 10.01]}, "translate": [1, 0, 0]}}}))
+    path = manifest(tmp_path, [{"name": "slip", "mesh": BAR, "handles": str(h),
+                                "output": "slip.obj"}])
+    out = tmp_path / "out"
+    r, rows = run(path, out)
+    assert r.exit_code == 0 and rows["slip"]["status"] == "ok"
+    made = (out / "slip.obj").stat().st_mtime_ns
+    r, rows = run(path, out, "--strict")
+    assert r.exit_code == 8 and rows["slip"]["status"] == "failed"
+    assert rows["slip"]["exit_code"] == "4" and "[rigid-part]" in rows["slip"]["message"]
+    assert "strict: warnings about the request are errors" in rows["slip"]["message"]
+    r, rows = run(path, out, "--strict", "--allow", "rigid-part")
+    assert r.exit_code == 0 and rows["slip"]["status"] == "up-to-date"
+    assert (out / "slip.obj").stat().st_mtime_ns == made  # never solved again
+    strict_in_file = tmp_path / "strict.yaml"
+    strict_in_file.write_text(h.read_text() + "solver: {strict: true}\n")
+    path = manifest(tmp_path, [{"name": "slip", "mesh": BAR, "handles": str(strict_in_file),
+                                "output": "slip.obj"}])
+    r, rows = run(path, out)  # another handle file: solved, and failed by its own strict
+    assert r.exit_code == 8 and rows["slip"]["status"] == "failed"

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import yaml
 from click.testing import CliRunner
-from helpers import ROOT, tube_mesh
+from helpers import ROOT, run_cli, tube_mesh
 
 from srarap_cli.cli import main
 from srarap_cli.io.mesh import read_mesh, write_mesh
@@ -217,3 +217,14 @@ def test_the_public_api_is_reachable_from_the_package():
         assert getattr(srarap_cli, name) is not None
     with pytest.raises(AttributeError):
         srarap_cli.no_such_name  # noqa: B018
+
+
+@pytest.mark.parametrize("args, words", [
+    (["defrom", "m.obj", "h.yaml"], "No such command 'defrom'. Did you mean 'deform'?"),
+    (["deform", "m.obj", "h.yaml", "-o", "x.obj", "--strict", "all"],
+     "(all); a level of --strict goes after an equals sign: --strict=all"),
+])
+def test_a_usage_slip_gets_what_it_most_likely_meant(args, words):
+    """Issue 70: 'srarap defrom' got no "did you mean", '--strict all' no hint."""
+    r = run_cli(args)
+    assert r.returncode == 2 and words in r.stderr and len(r.stderr.splitlines()) == 1

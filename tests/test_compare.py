@@ -156,3 +156,17 @@ def test_compare_update_writes_the_golden_only_when_missing_or_beyond(pair, tmp_
     assert r.exit_code == 4 and "is mesh A; refusing to overwrite an input" in r.stderr
     r = run(a, "-", "--update")
     assert r.exit_code == 2 and "B cannot be '-'" in r.stderr
+
+
+def test_a_percentage_tolerance_is_of_the_diagonal(pair, tmp_path):
+    """Issue 70: --tol 1% was refused though --multires takes percentages."""
+    m, a, b = pair
+    diag = np.linalg.norm(np.ptp(m.vertices, axis=0))
+    at = 100 * 0.25 / diag  # the lift, as a percentage of the diagonal
+    assert run(a, b, "--tol", f"{at * 1.01}%").exit_code == 0
+    r = run(a, b, "--tol", f"{at * 0.99}%")
+    assert r.exit_code == 7 and "of the diagonal" in r.stderr
+    assert run(a, b, "--tol", "x%").exit_code == 2 and run(a, b, "--tol", "-1%").exit_code == 2
+    from srarap_cli.tasks.comparison.gates import parse_expect
+    e = parse_expect({"golden": "g", "tol": "0.5%"}, ValueError)
+    assert e.tol == 0.005 and e.relative

@@ -338,9 +338,9 @@ def test_a_job_committed_just_before_the_signal_is_ok_in_the_summary(slow_batch,
     p = subprocess.Popen([sys.executable, "-m", "srarap_cli", "batch", "jobs.yaml", "-o",
                           str(out), "--workers", "2", *extra], cwd=slow_batch,
                          stderr=subprocess.PIPE, start_new_session=True)
-    deadline, first = time.monotonic() + 120, []
-    while not first:  # the first job committed (either worker's)
-        assert time.monotonic() < deadline and p.poll() is None
+    first = []
+    while not first:  # the first job committed (either worker's); a hang is the run's timeout
+        assert p.poll() is None
         first = [f.name for f in out.iterdir() if f.name.endswith(".srarap.json")] \
             if out.is_dir() else []
         time.sleep(0.01)

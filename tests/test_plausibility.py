@@ -139,7 +139,7 @@ def test_strict_refuses_mesh_warnings_too(tmp_path):
 
 def test_a_manifest_job_with_strict_fails_with_the_warning(tmp_path):
     h = tmp_path / "h.yaml"
-    h.write_text(yaml.safe_dump({"groups": {"base": BASE, "top": dict(TOP, translate=[0, 0, 99])}}))
+    h.write_text(yaml.safe_dump({"groups": {"base": BASE, "top": dict(TOP, translate=[0, 0, 20])}}))
     jobs = [{"name": "far", "mesh": BAR, "handles": str(h), "output": "far.obj",
              "settings": {"strict": True}},
             {"name": "lenient", "mesh": BAR, "handles": str(h), "output": "lenient.obj"}]
@@ -156,7 +156,7 @@ def test_a_manifest_job_with_strict_fails_with_the_warning(tmp_path):
 
 def test_the_api_raises_under_strict_and_lists_the_warning_otherwise():
     mesh = read_mesh(BAR)
-    doc = {"groups": {"base": BASE, "top": dict(TOP, translate=[0, 0, 99])}}
+    doc = {"groups": {"base": BASE, "top": dict(TOP, translate=[0, 0, 20])}}
     result = srarap_cli.deform(mesh, doc, max_iter=5)
     assert any("bounding-box diagonal" in w for w in result.warnings)
     with pytest.raises(ValueError, match="bounding-box diagonal"):
@@ -182,3 +182,19 @@ def test_info_reports_what_deform_would_warn_about_the_handle_file(tmp_path):
     assert r.exit_code == 0 and "  warning: " in r.output and "angle_rad 30" in r.output
     r = CliRunner().invoke(main, ["info", BAR, str(h), "--json"])
     assert any("angle_rad 30" in w for w in yaml.safe_load(r.output)["warnings"])
+
+
+def test_targets_several_diagonals_away_are_refused_at_once_unless_allowed(tmp_path):
+    """A units slip (13.5 diagonals, as an audit's user made) is exit 4 before the setup,
+    with the handle file's own line; --allow units solves it (and still says it)."""
+    h = tmp_path / "h.yaml"
+    h.write_text(yaml.safe_dump({"groups": {"base": BASE, "top": dict(TOP, translate=[0, 0, 140])}}))
+    r = CliRunner().invoke(main, ["deform", BAR, str(h), "-o", str(tmp_path / "o.obj")])
+    assert r.exit_code == 4 and not (tmp_path / "o.obj").exists()
+    assert "13.5 times the mesh's bounding-box diagonal" in r.stderr
+    assert "--allow units solves them" in r.stderr and len(r.stderr.splitlines()) == 1
+    r = CliRunner().invoke(main, ["deform", BAR, str(h), "-o", str(tmp_path / "o.obj"),
+                                  "--allow", "units", "--max-iter", "3", "--keep-unconverged"])
+    assert r.exit_code in (0, 3) and "[units]" in r.stderr
+    with pytest.raises(ValueError, match="--allow units"):
+        srarap_cli.deform(read_mesh(BAR), (np.array([0]), np.array([[0.0, 0, 1000]])))

@@ -206,3 +206,15 @@ def test_the_reduced_picture_looks_like_the_full_one(tmp_path, monkeypatch):
     shape_a, shape_b = a.min(axis=-1) < 0.99, b.min(axis=-1) < 0.99
     assert (shape_a != shape_b).mean() < 0.01  # the silhouettes agree but for a few pixels
     assert np.abs(a - b)[shape_a & shape_b].mean() < 0.03  # and the shading inside them
+
+
+def test_render_is_quiet_with_q_and_says_where_a_gif_comes_from(tmp_path):
+    """Issue 70: render had no -q, and -o x.gif for one mesh said only '.png'."""
+    lying = tmp_path / "lying.obj"  # a y-up guess in doubt says its note
+    write_mesh(str(lying), tube_mesh())
+    loud = CliRunner().invoke(main, ["render", str(lying), "-o", str(tmp_path / "a.png")])
+    quiet = CliRunner().invoke(main, ["render", str(lying), "-o", str(tmp_path / "b.png"), "-q"])
+    assert loud.exit_code == quiet.exit_code == 0 and quiet.stderr == ""
+    assert (tmp_path / "a.png").read_bytes() == (tmp_path / "b.png").read_bytes()
+    r = CliRunner().invoke(main, ["render", BAR, "-o", str(tmp_path / "x.gif")])
+    assert r.exit_code == 2 and "frame pattern" in r.stderr and ".png" in r.stderr

@@ -183,6 +183,27 @@ class FiniteFloat(click.FloatRange):
         return out
 
 
+class Tolerance(click.ParamType):
+    """A distance tolerance: a finite number >= 0, or a percentage (``1%``: 0.01, relative
+    to the diagonal). Converts to ``(value, relative)``."""
+
+    name = "tol"
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        if isinstance(value, tuple):
+            return value
+        text = str(value).strip()
+        percent = text.endswith("%")
+        try:
+            number = float(text.removesuffix("%").strip())
+        except ValueError:
+            number = math.nan
+        if not (math.isfinite(number) and number >= 0):
+            self.fail(f"{value!r} is neither a number >= 0 nor a percentage (1%)", param, ctx)
+        return (number / 100, True) if percent else (number, False)
+
+
 class MeshFormatType(click.ParamType):
     """A registered mesh format's name, as its :class:`~srarap_cli.io.mesh.MeshFormat`;
     the choices are read from the format table when used, so a format registered after

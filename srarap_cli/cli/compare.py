@@ -3,14 +3,15 @@ import click
 
 from ..io.mesh.formats import MeshFormat
 from ..tasks.comparison import CompareJob, run_compare
-from .common import FiniteFloat, guarded, input_format_option, say
+from .common import FiniteFloat, Tolerance, guarded, input_format_option, say
 
 
 @click.command("compare")
 @click.argument("a")
 @click.argument("b")
-@click.option("--tol", type=FiniteFloat(min=0), default=0.0, show_default=True,
-              help="Largest allowed distance (model units, or a fraction with --relative).")
+@click.option("--tol", type=Tolerance(), default="0", show_default=True,
+              help="Largest allowed distance (model units, or a fraction with --relative); "
+                   "a percentage (1%) is of A's diagonal.")
 @click.option("--relative", is_flag=True,
               help="Distances as fractions of A's bounding-box diagonal.")
 @click.option("--beyond-tol", type=FiniteFloat(min=0, max=1), default=0.0, show_default=True,
@@ -37,7 +38,7 @@ from .common import FiniteFloat, guarded, input_format_option, say
 @click.option("-q", "--quiet", is_flag=True, help="No summary line.")
 @input_format_option
 @guarded
-def compare(a: str, b: str, tol: float, relative: bool, beyond_tol: float, p95: float | None,
+def compare(a: str, b: str, tol: tuple[float, bool], relative: bool, beyond_tol: float, p95: float | None,
             p99: float | None, align: str, update: bool, accept: bool, report: str | None,
             html_report: str | None, junit: str | None, markdown: str | None,
             metrics: str | None, quiet: bool, input_format: MeshFormat | None) -> None:
@@ -50,6 +51,8 @@ def compare(a: str, b: str, tol: float, relative: bool, beyond_tol: float, p95: 
     missing and --update wrote it (--accept: 0).
     """
     goldens = "accept" if accept else "update" if update else "check"
+    tol, percent = tol
+    relative = relative or percent
     done = run_compare(CompareJob(a, b, tol, relative, report, html_report, junit, input_format,
                                   beyond_tol, p95, p99, align, goldens, markdown, metrics))
     if not quiet or done.golden:

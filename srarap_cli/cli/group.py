@@ -1,5 +1,7 @@
 """The ``srarap`` command group: each subcommand in its own module, loaded on first use."""
+import difflib
 import importlib
+import re
 import sys
 from collections.abc import Sequence
 from typing import Any, NoReturn
@@ -12,6 +14,7 @@ from ..runtime import descriptors, exit_codes, limits, signals, streams
 from ..runtime.errors import InputError
 from ..runtime.lazy_modules import defer_unused_numpy_modules
 from ..runtime.threads import pin_process
+from ..runtime.warning_codes import LEVELS
 
 #: name -> (module, function, one-line help shown by ``srarap --help``)
 COMMANDS = {
@@ -39,6 +42,27 @@ COMMANDS = {
 def _leave_now(code: int, text: str) -> NoReturn:
     click.echo(f"srarap: error: {text}", err=True)
     sys.exit(code)
+
+
+def usage_hint(message: str) -> str:
+    """What a usage error most likely meant: a command's name misspelt, a strictness level
+    given after a space (``--strict all``: an optional value takes ``=``).
+
+    Examples
+    --------
+    >>> usage_hint("No such command 'defrom'.")
+    " Did you mean 'deform'?"
+    >>> usage_hint("Got unexpected extra argument (all)")
+    '; a level of --strict goes after an equals sign: --strict=all'
+    """
+    unknown = re.match(r"No such command '(.*)'", message)
+    if unknown:
+        close = difflib.get_close_matches(unknown[1], list(COMMANDS), n=1)
+        return f" Did you mean {close[0]!r}?" if close else ""
+    extra = re.match(r"Got unexpected extra arguments? \(([^)\s]+)", message)
+    if extra and extra[1] in LEVELS:
+        return f"; a level of --strict goes after an equals sign: --strict={extra[1]}"
+    return ""
 
 
 class LazyGroup(click.Group):
@@ -90,7 +114,8 @@ class LazyGroup(click.Group):
             sys.exit(exit_codes.TERMINATED)
         except click.UsageError as exc:
             where = exc.ctx.command_path if exc.ctx is not None else "srarap"
-            click.echo(f"srarap: error: {exc.format_message()} (see '{where} --help')", err=True)
+            click.echo(f"srarap: error: {exc.format_message()}{usage_hint(exc.format_message())}"
+                       f" (see '{where} --help')", err=True)
             sys.exit(exc.exit_code)
         except click.ClickException as exc:
             click.echo(f"srarap: error: {exc.format_message()}", err=True)

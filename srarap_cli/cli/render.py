@@ -8,7 +8,8 @@ from .common import FiniteFloat, guarded, input_format_option, say
 
 @click.command("render")
 @click.argument("mesh")
-@click.option("-o", "--output", "out", required=True, help="PNG to write.")
+@click.option("-o", "--output", "out", required=True,
+              help="PNG to write (a frame pattern: a GIF, or a PNG contact sheet).")
 @click.option("--handles", help="Handle file: its groups are coloured (selected on the rest shape).")
 @click.option("--rest", help="Rest mesh (same vertices): shown beside or behind, and needed "
               "for --color distortion.")
@@ -29,10 +30,11 @@ from .common import FiniteFloat, guarded, input_format_option, say
                                 "[default: 800x600; 480x360 a frame]")
 @click.option("--fps", type=FiniteFloat(min=1, max=50), default=12.0, show_default=True,
               help="Frames per second of an animated GIF.")
+@click.option("-q", "--quiet", is_flag=True, help="No note (the up-axis guess).")
 @input_format_option
 @guarded
 def render(mesh: str, out: str, handles: str | None, rest: str | None, color: str, layout: str,
-           up: str, views: tuple[str, ...], size: str | None, fps: float,
+           up: str, views: tuple[str, ...], size: str | None, fps: float, quiet: bool,
            input_format: MeshFormat | None) -> None:
     """Render MESH to a PNG, headless.
 
@@ -41,7 +43,7 @@ def render(mesh: str, out: str, handles: str | None, rest: str | None, color: st
     of up to 24 of them (-o sheet.png).
     """
     run_render(RenderJob(mesh, out, handles, rest, color, layout, up, tuple(views), size, fps,
-                         input_format), on_note=say)
+                         input_format), on_note=None if quiet else say)
 
 
 @click.command("plot")

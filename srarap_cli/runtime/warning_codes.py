@@ -50,6 +50,7 @@ CODES = {c.name: c for c in (
                                  "pose"),
     Code("short-way", REQUEST, "a static rotation beyond 180 degrees, which a solve turns the "
                                "short way"),
+    Code("non-unit-quaternion", REQUEST, "a quaternion whose length is not 1, normalized"),
     Code("not-rigid", REQUEST, "a matrix no rigid motion reaches (it mirrors, scales or "
                                "shears)"),
     Code("rigid-part", REQUEST, "a connected part held only by handles that move it rigidly: "

@@ -21,6 +21,7 @@ from ..solver.quaternion import IDENTITY
 from ..solver.region import restrict
 from ..solver.result import DeformResult
 from ..solver.settings import STAGES, Settings, resolve, with_keywords
+from .far_targets import refuse_far_targets
 from .rigid_parts import rigid_part_warnings
 from .still_requests import still_request_warnings
 
@@ -111,6 +112,8 @@ def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = N
     mark = time.perf_counter()
     notes = list(handle_warnings) + mesh_warnings(mesh.vertices, mesh.triangles()[0])
     if constraints is not None:
+        if still:  # a units slip costs seconds, not a solve of minutes
+            refuse_far_targets(mesh.vertices, constraints, opts.allow, notes)
         notes += request_warnings(mesh, p, constraints, still)
     stage_ended("checks", time.perf_counter() - mark)
     if failing(notes, opts.strict, opts.allow):  # with what the setup would say: all at once

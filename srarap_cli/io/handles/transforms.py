@@ -38,9 +38,13 @@ def rotation_matrix(ctx: Context, spec: dict) -> np.ndarray:
         key = quats[0]
         order = "x, y, z, w" if key == "quaternion_xyzw" else "w, x, y, z"
         q = _scaled(ctx.vector(spec[key], f"{key} [{order}]", 4)[QUATERNION_KEYS[key]])
-        if np.linalg.norm(q) < 1e-12:
+        norm = float(np.linalg.norm(q))
+        if norm < 1e-12:
             raise ctx.error(f"{key} must not be zero")
-        return to_matrix(q / np.linalg.norm(q))
+        if abs(norm - 1) > 1e-3:  # beyond its decimals' rounding: a typo, or not a rotation
+            ctx.warn("non-unit-quaternion", f"{key} has length {norm:.4g}, not 1: it was "
+                     "normalized (a component mistyped, or a vector given as a quaternion?)")
+        return to_matrix(q / norm)
     if len(angles) > 1:
         raise ctx.error(f"rotate takes one angle, got {' and '.join(angles)}: keep angle_deg "
                         "(degrees) or angle_rad (radians)")

@@ -102,10 +102,17 @@ max_seconds, p95, p99, relative, tol)
     for key in GATE_KEYS:
         if key in spec and spec[key] is not None:
             values[key] = _CHECKS[key](key, spec[key], fail)
+    if isinstance(spec.get("tol"), str) and spec["tol"].strip().endswith("%"):
+        if spec.get("relative") is False:
+            raise fail("expect: tol as a percentage is of the diagonal: relative cannot be "
+                       "false")
+        values.update(tol=values["tol"] / 100, relative=True)
     return Expect(**values)
 
 
 def _number(key, value, fail, upper=math.inf):
+    if key == "tol" and isinstance(value, str) and value.strip().endswith("%"):
+        value = value.strip()[:-1]  # a percentage of the diagonal (parse_expect scales it)
     value = spelled(value)  # YAML reads 1e-6 (no dot) as text
     try:
         good = not isinstance(value, bool) and isinstance(value, (int, float)) \

@@ -13,12 +13,13 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from ...io.documents import load_document
 from ...io.mesh.formats import FORMATS, MeshFormat, by_extension, extensions
 from ...io.solve_log import LOG_FORMATS, format_log
 from ...runtime import descriptors, memory
 from ...runtime.commit import commit_files
 from ...runtime.encoding import utf8
-from ...runtime.errors import NumericalError, OutputError, UsageProblem
+from ...runtime.errors import InputError, NumericalError, OutputError, UsageProblem
 from ...runtime.failures import classify
 from ...runtime.limits import check_solve
 from ...runtime.stages import ended as stage_ended
@@ -185,12 +186,36 @@ def recorded_result(job: DeformJob, key: str | None = None) -> JobResult | None:
         status = JobStatus.UP_TO_DATE
     elif not (status is JobStatus.NOT_CONVERGED and not job.keep_unconverged):
         return None  # the output is gone, or this run writes what that one did not
-    return JobResult(job.name, status, status.exit_code, warnings=rec["warnings"],
-                     stop=rec["stop"] or "", iterations=rec["iterations"],
-                     energy=rec["energy"], solved=False,
-                     message="" if status is JobStatus.UP_TO_DATE
-                     else "inputs unchanged since the recorded run",
-                     seen={"recorded_seconds": rec["seconds"]})
+    result = JobResult(job.name, status, status.exit_code, warnings=rec["warnings"],
+                       stop=rec["stop"] or "", iterations=rec["iterations"],
+                       energy=rec["energy"], solved=False,
+                       message="" if status is JobStatus.UP_TO_DATE
+                       else "inputs unchanged since the recorded run",
+                       seen={"recorded_seconds": rec["seconds"]})
+    return _judged(job, result)
+
+
+def _judged(job, result):
+    """An unchanged job's recorded warnings judged under this run's strictness, which is not
+    in the fingerprint (it decides nothing in the mesh): ``failed`` with the line ``--strict``
+    gives where it fails them, the files of the recorded run left as they are."""
+    try:
+        refuse_warnings(_strictness(job), result.warnings)
+    except InputError as exc:
+        code, text = classify(exc)
+        result.status, result.exit_code, result.message = JobStatus.FAILED, code, text
+    return result
+
+
+def _strictness(job):
+    """The settings ``strict`` and ``allow`` come from: the handle file's ``solver`` block
+    under the job's settings, as a solve resolves them."""
+    try:
+        doc = load_document(job.handles, "yaml")
+        solver = doc.get("solver") if isinstance(doc, dict) else None
+        return resolve(solver if isinstance(solver, dict) else {}, dict(job.settings))
+    except (InputError, ValueError, TypeError):  # not a YAML handle file: the job's alone
+        return resolve(dict(job.settings))
 
 
 def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):

@@ -78,6 +78,9 @@ def run_render(job: RenderJob, on_note: Callable[[str], None] | None = None) -> 
     if "{" in job.mesh:
         _frames(job, on_note)
         return job.out
+    if job.out.lower().endswith(".gif"):
+        raise UsageProblem(f"output {job.out!r}: a GIF is an animation's: give MESH as a frame "
+                           "pattern ('frames/f_{:04d}.obj'); one mesh renders to .png")
     check_output_path(job.out, (".png",), "output")
     size = pixel_size(job.size or "800x600")
     for view in job.views:
