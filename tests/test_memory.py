@@ -31,16 +31,22 @@ big = memory.stop(first)
 second = memory.start()
 touch(20)
 small = memory.stop(second)
-print(big, small, memory.stop(outer))
+whole = memory.stop(outer)
+import resource
+print(big, small, whole, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+      memory.status_bytes("VmHWM"))
 """
 
 
 def test_a_stage_sees_the_memory_it_touched_and_a_later_stage_does_not():
     out = subprocess.run([sys.executable, "-c", STAGES], capture_output=True, text=True,
                          check=True).stdout
-    big, small, whole = map(int, out.split())
-    assert big - small > 150 * MB  # the reset: the second stage did not inherit the first's
+    big, small, whole, maxrss, hwm = map(int, out.split())
+    assert big - small > 150 * MB  # the second stage did not inherit the first's peak
     assert whole >= big  # the enclosing stage keeps the peak of everything inside it
+    # nothing reset what the kernel says of the process (/usr/bin/time, ru_maxrss): the
+    # process's peak is the largest stage's, as -v says it
+    assert maxrss >= big and hwm == whole
 
 
 def test_closing_an_unmeasured_stage_gives_none_and_formatting_skips_it():

@@ -127,7 +127,8 @@ verbosity_options = [
     click.option("-q", "--quiet", "verbosity", flag_value=0,
                  help="Errors and warnings only (no summary line)."),
     click.option("-v", "--verbose", "verbosity", flag_value=2,
-                 help="Also the stages and their timings."),
+                 help="Also the stages, their timings and peak memory (sampled: nothing "
+                 "reset, /usr/bin/time stays true)."),
 ]
 
 

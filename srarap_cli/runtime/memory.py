@@ -1,30 +1,36 @@
-"""Peak resident memory per stage of a run, for ``-v`` and the large-mesh benchmark.
+"""Peak resident memory per stage of a run, for ``-v`` and the large-mesh benchmark, without
+touching what the kernel reports of the process (``/usr/bin/time``, ``ru_maxrss``).
 
-Linux keeps one high-water mark per process (``VmHWM``) and lets a process reset it
-(``/proc/self/clear_refs``); ``ru_maxrss`` only ever grows, so it cannot say which stage set
-it. Stages nest (a coarse level's setup inside the fine level's), so a reset folds the mark
-reached so far into every stage still open before clearing it: each stage's figure is the
-highest resident size between its start and its end, whatever opened or closed inside.
-Elsewhere (no ``/proc``) every figure is None.
+Linux keeps one high-water mark per process (``VmHWM``), which only grows here: srarap never
+resets it (``/proc/self/clear_refs`` would, and then ``/usr/bin/time`` reported half the peak
+a run needed). A stage during which the mark rose set a new peak of the process, and that
+mark is its peak, exactly; a stage that stayed below an earlier one's is measured by
+sampling the resident size (``VmRSS``) every few milliseconds while it is open, so a short
+spike within it can go unseen (its figure is then a little low, never high). Stages nest (a
+coarse level's setup inside the fine level's): each figure is the highest resident size
+seen between its start and its end, whatever opened or closed inside. Elsewhere (no
+``/proc``) every figure is None.
 
-Measuring is off until :func:`enable` (``-v`` turns it on): the reset also lowers what the
-kernel reports as the process's peak afterwards (``ru_maxrss``, ``/usr/bin/time``'s maximum
-resident size cover only the time since the last reset), which a run not asking for these
-figures must not have changed under it.
+Measuring is off until :func:`enable` (``-v`` turns it on): the sampling thread runs only
+while a stage is open.
 """
 import itertools
+import os
 import threading
 
 _STATUS = "/proc/self/status"
-_CLEAR = "/proc/self/clear_refs"
-_open: dict[int, int] = {}
+#: seconds between samples of the resident size while a stage is open
+EVERY = 0.005
+_open: dict[int, tuple[int, int]] = {}  # token -> (the mark at its start, the highest seen)
 _ids = itertools.count()
 _lock = threading.Lock()
+_wake = threading.Condition(_lock)
 _enabled = False
+_sampler: tuple[int, threading.Thread] | None = None  # its process (a fork has none)
 
 
 def enable() -> None:
-    """Measure from now on (see the module's note on what the reset changes)."""
+    """Measure from now on."""
     global _enabled
     _enabled = True
 
@@ -47,34 +53,39 @@ def _high_water():
     return status_bytes("VmHWM")
 
 
-def _reset():
-    try:
-        with open(_CLEAR, "w") as f:
-            f.write("5")
-        return True
-    except OSError:
-        return False
+def _sample():
+    """Fold the resident size into every open stage (with ``_lock`` held)."""
+    rss = status_bytes("VmRSS")
+    if rss is not None:
+        for token, (mark, seen) in _open.items():
+            _open[token] = (mark, max(seen, rss))
 
 
-def _fold():
-    mark = _high_water()
-    if mark is not None:
-        for token in _open:
-            _open[token] = max(_open[token], mark)
+def _run_sampler():
+    with _wake:
+        while True:
+            while not _open:
+                _wake.wait()
+            _sample()
+            _wake.wait(EVERY)
 
 
 def start() -> int | None:
     """Open a stage; returns its token (None where peaks cannot be measured, or measuring
     is not enabled)."""
+    global _sampler
     with _lock:
-        if not _enabled or _high_water() is None:
-            return None
-        _fold()
-        if not _reset():
+        mark = _high_water() if _enabled else None
+        if mark is None:
             return None
         token = next(_ids)
-        _open[token] = 0
-        _fold()
+        _open[token] = (mark, 0)
+        _sample()
+        if _sampler is None or _sampler[0] != os.getpid():
+            thread = threading.Thread(target=_run_sampler, name="srarap-memory", daemon=True)
+            thread.start()
+            _sampler = (os.getpid(), thread)
+        _wake.notify()
         return token
 
 
@@ -83,8 +94,12 @@ def stop(token: int | None) -> int | None:
     if token is None:
         return None
     with _lock:
-        _fold()
-        return _open.pop(token, None)
+        _sample()
+        mark, seen = _open.pop(token, (None, None))
+        if mark is None:
+            return None
+        now = _high_water()
+        return max(seen, now) if now is not None and now > mark else seen
 
 
 def gigabytes(peaks: dict[str, int | None]) -> str:

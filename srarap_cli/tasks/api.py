@@ -22,7 +22,7 @@ def deform(mesh: Any, handles: Any, /, *, callback: Callable[[dict], None] | Non
 
 
 @overload
-def deform(mesh: ArrayLike, handles: ArrayLike, constrained: ArrayLike, targets: ArrayLike, /,
+def deform(V: ArrayLike, F: ArrayLike, constrained: ArrayLike, targets: ArrayLike, /,
            *, callback: Callable[[dict], None] | None = None, cache: str | None = None,
            initial: tuple[np.ndarray, np.ndarray] | None = None,
            settings: Settings | None = None, **options: Any) -> DeformResult: ...

@@ -37,12 +37,14 @@ def rotation_matrix(ctx: Context, spec: dict) -> np.ndarray:
     if quats:
         key = quats[0]
         order = "x, y, z, w" if key == "quaternion_xyzw" else "w, x, y, z"
-        q = _scaled(ctx.vector(spec[key], f"{key} [{order}]", 4)[QUATERNION_KEYS[key]])
+        raw = ctx.vector(spec[key], f"{key} [{order}]", 4)[QUATERNION_KEYS[key]]
+        q = _scaled(raw)
         norm = float(np.linalg.norm(q))
         if norm < 1e-12:
             raise ctx.error(f"{key} must not be zero")
-        if abs(norm - 1) > 1e-3:  # beyond its decimals' rounding: a typo, or not a rotation
-            ctx.warn("non-unit-quaternion", f"{key} has length {norm:.4g}, not 1: it was "
+        length = norm * float(np.abs(raw).max())  # of the components as written
+        if abs(length - 1) > 1e-3:  # beyond its decimals' rounding: a typo, or not a rotation
+            ctx.warn("non-unit-quaternion", f"{key} has length {length:.4g}, not 1: it was "
                      "normalized (a component mistyped, or a vector given as a quaternion?)")
         return to_matrix(q / norm)
     if len(angles) > 1:
