@@ -23,6 +23,7 @@ from ..tasks.job_status import JobStatus, batch_exit_code
 from ..tasks.preflight import check_output_path
 from .common import guarded, printable, say
 from .options import StrictCommand, setting_option
+from .progress import job_heartbeat
 
 #: a Dask scheduler address: protocol://host:port, or host:port
 SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
@@ -101,7 +102,8 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         check_output_path(os.path.join(out, name), None, "summary")
     try:
         rows, stopped = run_batch(jobs, out, workers, scheduler, keep_unconverged,
-                                  pictures=report is not None, threads=threads), None
+                                  pictures=report is not None, threads=threads,
+                                  heartbeat=None if quiet else job_heartbeat), None
     except BatchInterrupted as exc:  # the workers are stopped: say what finished
         rows, stopped = exc.rows, exc.signal
         # the summary is what is left to do: a second Ctrl-C or SIGTERM (a CI runner's

@@ -1,10 +1,18 @@
-"""Progress of a long solve on stderr: a line redrawn in place on a terminal, a line every
+"""Progress of a long run on stderr: a line redrawn in place on a terminal, a line every
 :data:`LOG_EVERY` seconds elsewhere (a CI log, ``make``, a file), so that a long run shows life
-and a hang can be told from work; ``-q`` silences both."""
+and a hang can be told from work; ``-q`` silences both. Between a solve's iterations the
+line is theirs; in every other long stage (reading, simplifying, setting up, a coarse
+level's solve) a heartbeat names the stages running and their levels
+(:func:`srarap_cli.runtime.stages.running`)."""
+import contextlib
 import os
 import sys
+import threading
 import time
+from collections.abc import Iterator
 from typing import Any
+
+from ..runtime import stages
 
 #: Seconds before the terminal's line appears (short runs stay silent) and between redraws.
 DELAY, EVERY = 2.0, 0.2
@@ -33,8 +41,9 @@ class SolveProgress:
     terminal : bool, stderr is a terminal (default: asked of it)
     """
 
-    def __init__(self, enabled: bool, terminal: bool | None = None) -> None:
+    def __init__(self, enabled: bool, terminal: bool | None = None, prefix: str = "") -> None:
         self.enabled = enabled
+        self.prefix = prefix
         self.terminal = sys.stderr.isatty() if terminal is None else terminal
         self.every = EVERY if self.terminal else log_interval()
         self.delay = DELAY if self.terminal else self.every
@@ -42,12 +51,28 @@ class SolveProgress:
         self.last = 0.0
         self.shown = False
         self.levels = False  # a row named its level: the solve has a coarse mesh
+        self.last_row = -float("inf")  # when the solve last sent a row (they say its state)
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        if enabled:
+            threading.Thread(target=self._beat, name="srarap-heartbeat", daemon=True).start()
+
+    def _beat(self) -> None:
+        """While no row said anything for an interval, name the stages running."""
+        while not self._stop.wait(min(self.every, 1.0) / 4):
+            now = time.perf_counter() - self.start
+            if now < self.delay or now - max(self.last, self.last_row) < self.every:
+                continue
+            busy = stages.running()
+            if busy:
+                self._show("; ".join(f"{name} {seconds:.1f} s" for name, seconds in busy)
+                           + f"  ({now:.1f} s in all)")
 
     def __call__(self, row: dict[str, Any]) -> None:
         if not self.enabled:
             return
         self.levels = self.levels or "level" in row
-        now = time.perf_counter() - self.start
+        now = self.last_row = time.perf_counter() - self.start
         if now < self.delay or now - self.last < self.every:
             return
         self.last, self.shown = now, True
@@ -56,9 +81,13 @@ class SolveProgress:
                    f"change {row['rel_change']:.2g}  {now:.1f} s")
 
     def _show(self, text: str) -> None:
-        # on a terminal the line is cleared first: a shorter one left the longer one's tail
-        sys.stderr.write(f"\r\033[K{text}" if self.terminal else f"srarap: progress: {text}\n")
-        sys.stderr.flush()
+        # on a terminal the line is cleared first: a shorter one left the longer one's tail;
+        # the time it was stamped at is the time it is written (one writer at a time)
+        with self._lock:
+            self.last, self.shown = time.perf_counter() - self.start, True
+            sys.stderr.write(f"\r\033[K{self.prefix}{text}" if self.terminal
+                             else f"srarap: progress: {self.prefix}{text}\n")
+            sys.stderr.flush()
 
     def say(self, line: str) -> None:
         """Print ``line`` on stderr, on a terminal over the progress line (redrawn at the next
@@ -71,6 +100,7 @@ class SolveProgress:
         self.say(f"srarap: stage: {name} {seconds:.2f} s")
 
     def close(self) -> None:
+        self._stop.set()
         if self.shown and self.terminal:
             sys.stderr.write("\r\033[K")
             sys.stderr.flush()
@@ -95,3 +125,15 @@ class FrameProgress(SolveProgress):
         rate = done / max(now, 1e-9)
         self._show(f"frame {done}/{total}  {rate:.2f} frames/s  "
                    f"ETA {(total - done) / max(rate, 1e-9):.0f} s  {now:.1f} s")
+
+
+@contextlib.contextmanager
+def job_heartbeat(name: str) -> Iterator[None]:
+    """A batch job's heartbeat in the log of the process that runs it (the batch, a worker
+    process, a Dask worker): its stages named every :func:`log_interval` seconds while it
+    runs long (lines, never a redrawn one: the batch's own lines share the stream)."""
+    beat = SolveProgress(enabled=True, terminal=False, prefix=f"job {name!r}: ")
+    try:
+        yield
+    finally:
+        beat.close()

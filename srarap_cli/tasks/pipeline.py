@@ -10,6 +10,7 @@ from ..io.handles import Constraints
 from ..io.mesh import Mesh
 from ..runtime.allocator import keep_freed_memory, one_arena
 from ..runtime.errors import InputError
+from ..runtime.stages import begun as stage_begun
 from ..runtime.stages import ended as stage_ended
 from ..runtime.warning_codes import failing
 from ..solver.deformer import unanchored, weight_warnings
@@ -110,6 +111,7 @@ def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = N
     run, not after it)."""
     one_arena()  # before the checks and the setup start threads
     mark = time.perf_counter()
+    stage_begun("checks")
     notes = list(handle_warnings) + mesh_warnings(mesh.vertices, mesh.triangles()[0])
     if constraints is not None:
         if still:  # a units slip costs seconds, not a solve of minutes
@@ -121,6 +123,7 @@ def command_solver(mesh: Mesh, p: Problem, opts: Settings, cache: str | None = N
     if on_warnings is not None:
         on_warnings(list(notes))
     mark = time.perf_counter()
+    stage_begun("setup")
     deformer = make_deformer(p.V, p.F, p.ids, p.labels, settings=opts, area=p.area,
                              cache=cache)
     stage_ended("setup", time.perf_counter() - mark)
@@ -210,6 +213,7 @@ def deform_mesh(mesh: Mesh, constraints: Constraints, settings: Settings | None 
     deformer, notes = command_solver(mesh, p, settings, cache, constraints.warnings,
                                      constraints, on_warnings)
     mark = time.perf_counter()
+    stage_begun("solve")
     sub_result = deformer.solve(p.targets, callback=callback)
     stage_ended("solve", time.perf_counter() - mark)
     positions = scatter(mesh, p, sub_result.positions, constraints)

@@ -14,6 +14,8 @@ from numpy.typing import ArrayLike
 from ...runtime import memory
 from ...runtime.errors import NumericalError
 from ...runtime.parallel import using_threads
+from ...runtime.stages import begun as stage_begun
+from ...runtime.stages import deeper
 from ...runtime.stages import ended as stage_ended
 from ...runtime.threads import background, single_threaded
 from ...runtime.warning_codes import note, reworded
@@ -58,6 +60,11 @@ class _Delayed:
     def __call__(self, state: Any, residual: np.ndarray) -> np.ndarray | None:
         assert self.correction is not None  # due() came first
         return self.correction(state, residual)
+
+
+def _begun(key):
+    """A stage begins (a heartbeat names it), under the summary's name for it."""
+    stage_begun(f"multires: {STAGE_NAMES[key]}")
 
 
 def _ended(key, seconds):
@@ -147,6 +154,7 @@ class MultiresDeformer:
     def _setup(self, V, F, constrained, labels, size, cache, area):
         self.mode = self.settings.multires_mode
         start, peak = time.perf_counter(), memory.start()
+        _begun("simplify")
         self.V, self.F = api_checks.mesh_arrays(V, F)
         self.constrained = api_checks.vertex_ids(constrained, len(self.V))
         size = coarse_size(self.settings.multires, len(self.V)) if size is None else size
@@ -245,6 +253,7 @@ class MultiresDeformer:
         """Build the full-resolution Deformer, hand it to ``built`` (a Future), then factor
         it (refine mode); returns the seconds of both."""
         mark = time.perf_counter()
+        _begun("factor")
         try:
             fine = Deformer(self.V, self.F, self.constrained, settings=self.settings, area=area,
                             labels=self.labels, prepare=False)
@@ -261,6 +270,7 @@ class MultiresDeformer:
 
     def _build_coarse(self, cache):
         start = time.perf_counter()
+        _begun("coarse_precompute")
         cv = self.coarse.vertices
         slot = np.full(len(self.V), -1)
         slot[self.constrained] = np.arange(self.constrained.size)
@@ -274,8 +284,10 @@ class MultiresDeformer:
             self.coarse_deformer = Deformer(*args, settings=self.settings, area=self.area,
                                             labels=labels)
         else:  # a level between: coarse-to-fine and corrections from a coarser mesh again
-            self.coarse_deformer = MultiresDeformer.or_direct(
-                *args, labels, settings=self.settings, size=size, cache=cache, area=self.area)
+            with deeper():  # its stages are the coarse level's
+                self.coarse_deformer = MultiresDeformer.or_direct(
+                    *args, labels, settings=self.settings, size=size, cache=cache,
+                    area=self.area)
         self.stages["coarse_precompute"] = _ended("coarse_precompute",
                                                   time.perf_counter() - start)
 
@@ -312,10 +324,12 @@ class MultiresDeformer:
         warm = None if initial is None else (np.asarray(initial[0])[cv],
                                               np.asarray(initial[1])[cv])
         peak = memory.start()
+        _begun("coarse_solve")
         try:
-            coarse = self.coarse_deformer.solve(targets[self._coarse_slots], initial=warm,
-                                                callback=_on_level(callback, "coarse mesh"),
-                                                settings=s, start=start)
+            with deeper():
+                coarse = self.coarse_deformer.solve(targets[self._coarse_slots], initial=warm,
+                                                    callback=_on_level(callback, "coarse mesh"),
+                                                    settings=s, start=start)
         except Exception:
             self._settle()
             raise
@@ -327,10 +341,12 @@ class MultiresDeformer:
         if self.mode == "transfer":
             return self._transfer(targets, coarse, log, stages, begin, peaks)
         mark, peak = time.perf_counter(), memory.start()
+        _begun("fine_start")
         first = self._fine_start(targets, s.tol, coarse, start or s.start)
         stages["fine_start"] = _ended("fine_start", time.perf_counter() - mark)
         peaks["fine_start"] = memory.stop(peak)
         mark, peak = time.perf_counter(), memory.start()
+        _begun("fine_iterations")
         fine = self.fine.solve(targets, initial=first, start="extrapolated", callback=callback,
                                driver=self._driver(targets, s.tol, s.accel), settings=s)
         stages["fine_iterations"] = _ended("fine_iterations", time.perf_counter() - mark)

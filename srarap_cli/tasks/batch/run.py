@@ -16,9 +16,12 @@ A job is up to date when its output exists and the sidecar ``<output>.srarap.jso
 the same fingerprint (content of the mesh, the handle file and every file it names, settings,
 srarap version).
 """
+import contextlib
 import functools
 import os
 import time
+from collections.abc import Callable
+from contextlib import AbstractContextManager
 from typing import Any
 
 from ...io.handles import load_handles
@@ -34,7 +37,8 @@ from .worker_pool import PoolStopped, run_in_processes
 
 
 def run_job(job: Job, out_dir: str, keep_unconverged: bool = False,
-            pictures: bool = False, threads: int | None = None) -> JobResult:
+            pictures: bool = False, threads: int | None = None,
+            heartbeat: Callable[[str], AbstractContextManager[Any]] | None = None) -> JobResult:
     """Run one job of a manifest through the job runner (:func:`.job.run_job_safely`);
     never raises. With ``pictures``, the result carries the report's pictures of the job
     (see :func:`job_pictures`).
@@ -42,9 +46,11 @@ def run_job(job: Job, out_dir: str, keep_unconverged: bool = False,
     A job that does not converge writes its record (the status, so a rerun reports it
     without solving again) but not its mesh, unless ``keep_unconverged``: as ``srarap
     deform``. ``threads``: the threads its solve runs, and the most it may run (its own
-    ``threads`` setting, where smaller, stands)."""
+    ``threads`` setting, where smaller, stands). ``heartbeat(name)``: a context that says the
+    job's stages while it runs long (a picklable function: workers call it)."""
     spec = deform_job(job, out_dir, keep_unconverged)
-    with at_most(threads or available_cpus()), using_threads(threads):
+    beat = heartbeat(job["name"]) if heartbeat is not None else contextlib.nullcontext()
+    with beat, at_most(threads or available_cpus()), using_threads(threads):
         result = run_job_safely(spec)
     if pictures:  # after the seconds: the solve's, not the drawing's
         result.pictures = job_pictures(job, spec.output, result.seen)
@@ -82,7 +88,9 @@ def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
 
 def run_batch(jobs: list[Job],
               out_dir: str, workers: int = 1, scheduler: str | None = None, keep_unconverged: bool = False,
-              pictures: bool = False, threads: int | None = None) -> list[JobResult]:
+              pictures: bool = False, threads: int | None = None,
+              heartbeat: Callable[[str], AbstractContextManager[Any]] | None = None
+              ) -> list[JobResult]:
     """Run jobs: on a Dask cluster at ``scheduler``, else in ``workers`` local processes
     (in this process when 1). Rows come back in manifest order. ``keep_unconverged``: see
     :func:`run_job`. Each job's solve runs ``threads`` threads (default
@@ -90,10 +98,12 @@ def run_batch(jobs: list[Job],
     workers times threads stays within the CPUs (:func:`job_threads`).
 
     The Dask workers must see the same files as this process (a shared file system).
+    ``heartbeat``: see :func:`run_job`.
     """
     since = time.time()
     run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged,
-                            pictures=pictures, threads=job_threads(workers, threads))
+                            pictures=pictures, threads=job_threads(workers, threads),
+                            heartbeat=heartbeat)
     unfinished = functools.partial(interrupted_row, out_dir=out_dir,
                                    keep_unconverged=keep_unconverged, since=since)
     try:

@@ -22,7 +22,9 @@ from ...runtime.encoding import utf8
 from ...runtime.errors import InputError, NumericalError, OutputError, UsageProblem
 from ...runtime.failures import classify
 from ...runtime.limits import check_solve
+from ...runtime.stages import begun as stage_begun
 from ...runtime.stages import ended as stage_ended
+from ...runtime.stages import forget as forget_stages
 from ...solver.settings import resolve
 from ...solver.stop import StopReason
 from ..comparison import Expect
@@ -222,6 +224,8 @@ def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
     peaks: dict[str, int | None] = {}
     peak, mark = memory.start(), time.perf_counter()
     started = mark
+    forget_stages()  # a job before this one in the process that failed left its own
+    stage_begun("read")
     source, source_format = read_any_mesh(job.mesh, job.input_format)
     peaks["read"] = memory.stop(peak)
     stage_ended("read", time.perf_counter() - mark)
@@ -236,6 +240,7 @@ def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
     deformed, solve, notes = deform_mesh(source, constraints, opts, callback=callback,
                                          cache=job.cache, name=name, on_warnings=on_warnings)
     peaks["solve"], peak, mark = memory.stop(peak), memory.start(), time.perf_counter()
+    stage_begun("write")
     if job.write_distortion:
         deformed.vertex_data["distortion"] = vertex_distortion(
             source.vertices, deformed.vertices, source.triangles()[0])
