@@ -160,3 +160,29 @@ def test_a_file_size_limit_mid_write_leaves_every_output_as_it_was(folder):
     assert (folder / "o.obj").read_bytes() == b"previous mesh"
     assert (folder / "o.csv").read_bytes() == b"previous log"
     assert not [p for p in os.listdir(folder) if p.startswith(".srarap-")]
+
+
+@pytest.mark.parametrize("name", [".srarap-99999999999999999999-x.tmp",
+                                  ".srarap-99999999999999999999-abcdefgh.tmp",
+                                  ".srarap-4194305123-abcdefgh.tmp", ".srarap-12-notours.tmp",
+                                  ".srarap-0-abcdefgh.tmp"])
+def test_a_strangers_file_named_like_ours_is_left_alone_and_breaks_no_write(tmp_path, name):
+    """Issue 71 (EXIT-4): an id past a C long in such a name made every write in the folder
+    exit 1 (OverflowError); an id no process can have is someone else's file."""
+    from srarap_cli.runtime.commit import commit_files
+    stranger = tmp_path / name
+    stranger.write_text("theirs")
+    commit_files([(str(tmp_path / "out.obj"), b"mine")])
+    assert (tmp_path / "out.obj").read_bytes() == b"mine" and stranger.read_text() == "theirs"
+
+
+def test_a_dead_writers_leftover_is_still_swept(tmp_path):
+    import subprocess
+    import sys
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+    left = tmp_path / f".srarap-{dead}-abcd1234.tmp"
+    left.write_text("half")
+    from srarap_cli.runtime.commit import commit_files
+    commit_files([(str(tmp_path / "out.obj"), b"mine")])
+    assert not left.exists()

@@ -58,3 +58,20 @@ def test_front_shows_the_front_and_back_does_not(tmp_path, up, front):
         assert r.exit_code == 0, r.output
         shares[view] = _red_share(out.read_bytes())
     assert shares["front"] > 0.2 and shares["back"] < 0.01, shares
+
+
+@pytest.mark.parametrize("far", [1e5, 1e30, 1e150])
+def test_the_display_mesh_of_a_mesh_with_a_far_stray_vertex(far):
+    """Issue 71 (RENDER-1): one stray vertex 1e5 away on a large mesh made the display
+    mesh's grid numbers overflow ("negative dimensions are not allowed")."""
+    from helpers import tube
+
+    from srarap_cli.tasks.pictures.render import display_mesh
+    V, F = tube(rings=40, segments=30)
+    V = np.vstack([V, [[far, 0.0, 0.0]], [[-far, far, 0.0]]])  # in no face
+    W, G, colors, normals = display_mesh(V, F, np.ones((len(F), 3)), 200)
+    assert 0 < len(G) <= len(F) and np.isfinite(W).all() and G.max() < len(W)
+    assert colors.shape == (len(G), 3) and normals.shape == (len(G), 3)
+    tied = np.vstack([F, [[0, 1, len(V) - 1]]])  # in a face: the face is the picture
+    W, G, _, _ = display_mesh(V, tied, np.ones((len(tied), 3)), 200)
+    assert np.isfinite(W).all() and (G.max(initial=0) < len(W))

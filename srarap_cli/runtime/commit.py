@@ -8,6 +8,7 @@ or the pipe, which a reader (or the system) is using, with a regular file.
 """
 import glob
 import os
+import re
 import secrets
 import shutil
 import signal
@@ -222,15 +223,37 @@ def _stage(path, data):
     return tmp
 
 
+#: what :func:`_stage` names a file: its process id, then mkstemp's eight characters
+_OURS = re.compile(r"\.srarap-([1-9][0-9]{0,9})-[a-z0-9_]{8}\.tmp")
+
+
+def _writer(name):
+    """The process id in a name :func:`_stage` makes, or None for any other name (a
+    stranger's file, an id no process can have): such a file is never ours to delete."""
+    found = _OURS.fullmatch(name)
+    if found is None:
+        return None
+    pid = int(found[1])
+    return pid if pid <= _pid_max() else None
+
+
+def _pid_max():
+    try:
+        with open("/proc/sys/kernel/pid_max") as fh:
+            return int(fh.read())
+    except (OSError, ValueError):
+        return 2 ** 22  # Linux's largest
+
+
 def _sweep(folder):
     """Delete temporary files of srarap runs that no longer exist (a SIGKILL during staging
     leaves one behind); the writer's process id is in the name."""
     for tmp in glob.glob(os.path.join(glob.escape(folder), ".srarap-*-*.tmp")):
-        try:
-            pid = int(os.path.basename(tmp).split("-")[1])
-            os.kill(pid, 0)
-        except ValueError:  # not a name this module makes: not ours to delete
+        pid = _writer(os.path.basename(tmp))
+        if pid is None:  # not a name this module makes: not ours to delete
             continue
+        try:
+            os.kill(pid, 0)
         except ProcessLookupError:
             try:
                 os.unlink(tmp)

@@ -111,19 +111,28 @@ def display_mesh(V: np.ndarray, F: np.ndarray, colors: np.ndarray, budget: int
     a, b, c = (np.take(V, F[:, k], axis=0) for k in range(3))
     normals = np.cross(b - a, c - a)
     area = 0.5 * float(np.linalg.norm(normals, axis=1).sum())
-    lo = V.min(axis=0)
-    cell = max(np.sqrt(2.0 * area / max(budget, 1)), 1e-12 * float(np.ptp(V, axis=0).max()),
-               1e-300)
-    cells = np.floor((V - lo) / cell).astype(np.int64)
-    span = cells.max(axis=0) + 1
-    key = (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]
-    grid = int(np.prod(span))
+    used = np.zeros(len(V), dtype=bool)
+    used[F.ravel()] = True
+    drawn = V[used]  # a vertex in no face (a stray one far away) is not drawn
+    lo = drawn.min(axis=0)
+    cell = max(np.sqrt(2.0 * area / max(budget, 1)),
+               1e-12 * float(np.ptp(drawn, axis=0).max()), 1e-300)
+    # a stray vertex far away (or coordinates near a float's range) makes a grid whose cell
+    # numbers pass 64 bits: clamped, and the cells told apart by rows, not one number
+    steps = np.nan_to_num((V - lo) / cell, nan=0.0, posinf=2.0 ** 53)
+    cells = np.floor(np.clip(steps, 0, 2.0 ** 53)).astype(np.int64)
+    span = [int(x) + 1 for x in cells.max(axis=0)]
+    grid = span[0] * span[1] * span[2]  # Python's integers: no overflow
     if grid <= 8 * len(V):  # the cells' numbers by a pass over the grid, not a sort
+        key = (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]
         used = np.zeros(grid, dtype=bool)
         used[key] = True
         label = (np.cumsum(used) - 1)[key]
-    else:
+    elif grid < 2 ** 63:
+        key = (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]
         label = np.unique(key, return_inverse=True)[1].ravel()
+    else:
+        label = np.unique(cells, axis=0, return_inverse=True)[1].ravel()
     m = int(label.max()) + 1
     counts = np.bincount(label, minlength=m)
     W = np.column_stack([np.bincount(label, weights=V[:, k], minlength=m)
