@@ -606,3 +606,27 @@ def test_a_memory_failure_in_the_solve_is_exit_4_from_every_command(tmp_path, mo
     rows = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert r.returncode == 8 and rows[0]["exit_code"] == 4
     assert rows[0]["message"].startswith("out of memory")
+
+
+GROUP = "{box: {min: [-2, -2, -0.01], max: [2, 2, 0.01]}, fixed: true}"
+MOVE = "{box: {min: [-2, -2, 9.99], max: [2, 2, 10.01]}, translate: [1, 0, 0]}"
+
+
+@pytest.mark.parametrize("first, second, words", [
+    ("1", "0x1", "key '0x1' given twice in one mapping (line 3, the same key as '1')"),
+    ("1", "01", "the same key as '1'"),
+    ("true", "yes", "key 'yes' given twice"),
+    ("1", "true", "key 'true' given twice"),
+    ("1.0", "1", "key '1' given twice"),
+    ("1", '"1"', "group names 1 and '1' read as one name ('1')"),
+])
+def test_two_spellings_of_one_key_are_refused_by_value(tmp_path, first, second, words):
+    """Issue 71 (SILENT-2): keys were compared as spelt: ``1:`` and ``0x1:`` are one key,
+    and the first group was dropped with exit 0; ``1:`` and ``"1":`` are two groups that
+    every report names alike."""
+    h = tmp_path / "h.yaml"
+    h.write_text(f"groups:\n  {first}: {GROUP}\n  {second}: {MOVE}\n")
+    for command in (["info", BAR, h], ["deform", BAR, h, "-o", tmp_path / "o.obj"]):
+        r = run_cli(command)
+        assert r.returncode == 4 and words in r.stderr, r.stderr
+        assert len(r.stderr.splitlines()) == 1 and not (tmp_path / "o.obj").exists()

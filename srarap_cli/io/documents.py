@@ -234,15 +234,30 @@ def _unique(pairs, text, path):
 
 def _duplicate_key(node, path):
     """InputError for a YAML mapping that gives a key twice (the loader keeps the last one
-    silently), naming the key and the line of its second appearance."""
-    seen = set()
+    silently), naming the key and the line of its second appearance. Keys are compared as
+    the loader reads them, not as written: ``1``, ``0x1`` and ``01`` are one integer, ``true``
+    and ``yes`` one boolean (and, in the dictionary it makes, the same key as ``1``)."""
+    loader = yaml.SafeLoader("")
+    seen: dict[Any, str] = {}
     for key, _ in node.value:
         if not isinstance(key, yaml.ScalarNode) or key.value == "<<":  # merges: YAML's own
             continue
-        if (key.tag, key.value) in seen:
+        value = _key_value(loader, key)
+        if value in seen:
+            same = "" if seen[value] == key.value else f", the same key as {seen[value]!r}"
             raise InputError(f"{path}: key {key.value!r} given twice in one mapping (line "
-                             f"{key.start_mark.line + 1}); the first would be dropped")
-        seen.add((key.tag, key.value))
+                             f"{key.start_mark.line + 1}{same}); the first would be dropped")
+        seen[value] = key.value
+
+
+def _key_value(loader, key):
+    """A scalar key node as the loader reads it (its spelling where it cannot be read)."""
+    try:
+        value = loader.construct_object(key)
+        hash(value)
+        return value
+    except (yaml.YAMLError, TypeError, ValueError):
+        return (key.tag, key.value)
 
 
 def _check_tree(doc, path):

@@ -149,6 +149,17 @@ def _base(path):
     return os.getcwd() if is_stream(path) else os.path.dirname(os.path.abspath(path))
 
 
+def _alike_names(groups):
+    """Two group keys of different types that print alike (``1`` and ``"1"``): every report
+    names groups as text, where one would hide the other. None when all differ."""
+    seen: dict[str, Any] = {}
+    for key in groups:
+        if str(key) in seen:
+            return seen[str(key)], key
+        seen[str(key)] = key
+    return None
+
+
 def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = ".",
                   fps: float | None = None, any_rate: bool = False) -> "Constraints":
     """Validate an already-loaded handle document (dict) against ``V``; see :func:`load_handles`."""
@@ -159,6 +170,10 @@ def parse_handles(doc: Any, V: np.ndarray, path: str = "<handles>", base: str = 
         raise ctx.error("'groups' must map at least one group name to its selection and action")
     names, ids, tgts, tracks, actions = [], [], [], {}, {}
     diagonal = float(np.linalg.norm(np.ptp(V, axis=0))) if len(V) else 0.0
+    alike = _alike_names(groups)
+    if alike:
+        raise ctx.error(f"group names {alike[0]!r} and {alike[1]!r} read as one name "
+                        f"({str(alike[0])!r}): name them apart")
     for name, spec in groups.items():
         gctx = ctx.at(f"group {name!r}")
         spec = gctx.mapping(spec, "the group", SELECTOR_KEYS + ACTION_KEYS + ANIMATION_KEYS)
