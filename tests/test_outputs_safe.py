@@ -164,7 +164,7 @@ def test_a_file_size_limit_mid_write_leaves_every_output_as_it_was(folder):
 
 @pytest.mark.parametrize("name", [".srarap-99999999999999999999-x.tmp",
                                   ".srarap-99999999999999999999-abcdefgh.tmp",
-                                  ".srarap-4194305123-abcdefgh.tmp", ".srarap-12-notours.tmp",
+                                  ".srarap-4194305123-abcdefgh.tmp", ".srarap-12-not-ours.tmp",
                                   ".srarap-0-abcdefgh.tmp"])
 def test_a_strangers_file_named_like_ours_is_left_alone_and_breaks_no_write(tmp_path, name):
     """Issue 71 (EXIT-4): an id past a C long in such a name made every write in the folder

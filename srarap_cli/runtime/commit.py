@@ -223,8 +223,8 @@ def _stage(path, data):
     return tmp
 
 
-#: what :func:`_stage` names a file: its process id, then mkstemp's eight characters
-_OURS = re.compile(r"\.srarap-([1-9][0-9]{0,9})-[a-z0-9_]{8}\.tmp")
+#: what :func:`_stage` names a file: its process id, then mkstemp's random characters
+_OURS = re.compile(r"\.srarap-([1-9][0-9]{0,9})-[a-z0-9_]{1,32}\.tmp")
 
 
 def _writer(name):
