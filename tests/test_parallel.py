@@ -57,10 +57,10 @@ def test_the_affinity_mask_bounds_the_count(tmp_path, monkeypatch):
 
 def test_srarap_threads_sets_the_default_and_a_bad_value_is_named(monkeypatch):
     monkeypatch.setenv(parallel.ENV, "3")
-    assert parallel.current_threads() == 3
+    assert parallel.current_threads() == min(3, parallel.available_cpus())  # capped: below
     with using_threads(None) as count:
-        assert count == 3
-    for bad in ("0", "-2", "two", "1.5"):
+        assert count == min(3, parallel.available_cpus())
+    for bad in ("0", "-2", "two", "1.5", "1_0", "\u0662"):
         monkeypatch.setenv(parallel.ENV, bad)
         with pytest.raises(InputError, match=parallel.ENV):
             parallel.current_threads()
@@ -303,3 +303,37 @@ def test_every_failure_to_get_memory_or_a_thread_is_exit_4(exc, code):
     assert got == code and "\n" not in line
     if code == 4:
         assert line.startswith("out of memory")
+
+
+BAR = os.path.join(ROOT, "sample_meshes", "bar.obj")
+TWIST = os.path.join(ROOT, "configs", "bar-twist.yaml")
+
+
+@pytest.mark.parametrize("how", ["option", "variable", "setting"])
+def test_a_thread_count_past_the_cpus_is_capped_and_writes_the_same_bytes(tmp_path, how):
+    """Issue 71 (THREADS-1, -2): --threads 100000 reached rslab, which started that many
+    threads; a count rslab refused fell back to SuperLU with other bytes. Every count is
+    capped at the CPUs where it is resolved."""
+    with using_threads(10 ** 15):
+        assert parallel.current_threads() == parallel.available_cpus()
+    import yaml
+    doc = yaml.safe_load(open(TWIST))
+    if how == "setting":
+        doc.setdefault("solver", {})["threads"] = 100000
+    h = tmp_path / "h.yaml"
+    h.write_text(yaml.safe_dump(doc))
+    extra = ["--threads", "100000"] if how == "option" else []
+    forced = {"SRARAP_FACTOR": "rslab"}  # rslab starts the threads it is given
+    env = {**forced, parallel.ENV: "1000000000000000000"} if how == "variable" else forced
+    _srarap(tmp_path, "deform", BAR, str(h), "-o", "big.obj", *extra, env=env)
+    _srarap(tmp_path, "deform", BAR, TWIST, "-o", "one.obj", "--threads", "1", env=forced)
+    assert (tmp_path / "big.obj").read_bytes() == (tmp_path / "one.obj").read_bytes()
+
+
+@pytest.mark.parametrize("value", ["1_0", "\u0662", "1.5", "0"])
+def test_one_reading_of_a_thread_count_for_the_option_the_variable_and_the_key(tmp_path, value):
+    from srarap_cli.solver.settings import resolve
+    r = run_cli(["deform", BAR, TWIST, "-o", tmp_path / "o.obj", "--threads", value])
+    assert r.returncode == 2 and "positive whole number" in r.stderr
+    with pytest.raises(ValueError, match="positive whole number"):
+        resolve({"threads": value})

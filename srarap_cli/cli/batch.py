@@ -22,7 +22,7 @@ from ..tasks.batch import (
 from ..tasks.job_status import JobStatus, batch_exit_code
 from ..tasks.preflight import check_output_path
 from .common import guarded, printable, say
-from .options import StrictCommand, setting_option
+from .options import StrictCommand, ThreadCount, setting_option
 from .progress import job_heartbeat
 
 #: a Dask scheduler address: protocol://host:port, or host:port
@@ -55,7 +55,7 @@ SCHEDULER = re.compile(r"(?:[a-z][a-z0-9+.-]*://)?[^\s:/]+:\d{1,5}")
               "the run still exits 8: review what was written.")
 @click.option("--accept-goldens", is_flag=True, help="As --update-goldens, and those jobs "
               "pass: the new results are the truth.")
-@click.option("--threads", type=click.IntRange(min=1), metavar="N",
+@click.option("--threads", type=ThreadCount(), metavar="N",
               help="Threads for each job's solve, at most the CPUs divided by --workers. "
               "[default: $SRARAP_THREADS, else the CPUs divided by --workers]")
 @setting_option(BY_NAME["strict"])

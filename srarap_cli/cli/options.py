@@ -9,6 +9,7 @@ from typing import Any, TypeVar
 
 import click
 
+from ..runtime.parallel import thread_count
 from ..runtime.warning_codes import CODES, REQUEST
 from ..solver.multires.size import parse_size
 from ..solver.settings import MAX_INT, SETTINGS, Setting
@@ -37,6 +38,8 @@ def setting_option(setting: Setting, default: object = None) -> Callable[[F], F]
     elif setting.kind == "size":
         return click.option(setting.flag, callback=_size_option, metavar=setting.metavar,
                             help=text)
+    elif setting.kind == "count":
+        kind = ThreadCount()
     elif setting.kind == "int":
         low = None if setting.minimum is None else int(setting.minimum)
         kind = click.IntRange(min=low, min_open=setting.strict,
@@ -45,6 +48,20 @@ def setting_option(setting: Setting, default: object = None) -> Callable[[F], F]
         kind = FiniteFloat(min=setting.minimum, min_open=setting.strict, max=setting.maximum)
     return click.option(setting.flag, setting.name, type=kind, metavar=setting.metavar,
                         help=text)
+
+
+class ThreadCount(click.ParamType):
+    """A positive whole number in ASCII digits (``1_0`` and ``٢`` are refused, as in
+    ``$SRARAP_THREADS`` and a ``threads`` setting)."""
+
+    name = "integer"
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        count = thread_count(value)
+        if count is None:
+            self.fail(f"{value!r} is not a positive whole number", param, ctx)
+        return count
 
 
 class StrictCommand(click.Command):

@@ -149,23 +149,44 @@ def default_threads() -> int:
     text = os.environ.get(ENV, "").strip()
     if not text:
         return available_cpus()
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
+    value = thread_count(text)
+    if value is None:
         raise InputError(f"{ENV}={os.environ[ENV]!r}: expected a positive whole number of "
                          "threads")
     return value
 
 
+def thread_count(value: object) -> int | None:
+    """A thread count as every place that takes one reads it (``--threads``,
+    ``$SRARAP_THREADS``, the ``threads`` setting): a positive integer, or its ASCII digits
+    as text; None for anything else (``1_0``, ``٢``, ``1.5``, ``true``).
+
+    Examples
+    --------
+    >>> thread_count("12"), thread_count(3), thread_count("1_0"), thread_count("\u0662")
+    (12, 3, None, None)
+    """
+    if isinstance(value, str):
+        text = value.strip()
+        if not (text.isascii() and text.isdigit()):
+            return None
+        value = int(text)
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        return None
+    return value
+
+
 def current_threads() -> int:
     """The thread count of the code running now (see the module's docstring), within any
-    :func:`at_most` around it."""
+    :func:`at_most` around it, and never more than the CPUs this process may use
+    (:func:`available_cpus`): a larger request (``--threads 100000``) is capped here, where
+    every solve, factorization and pool asks, and since the results do not depend on the
+    count, the bytes do not either."""
     count = _count.get()
     count = default_threads() if count is None else count
     ceiling = _ceiling.get()
-    return count if ceiling is None else min(count, ceiling)
+    count = count if ceiling is None else min(count, ceiling)
+    return min(count, available_cpus())
 
 
 @contextlib.contextmanager
@@ -175,9 +196,9 @@ def at_most(ceiling: int) -> Iterator[None]:
 
     Examples
     --------
-    >>> with at_most(2), using_threads(8):
+    >>> with at_most(1), using_threads(8):
     ...     current_threads()
-    2
+    1
     """
     token = _ceiling.set(max(1, ceiling))
     try:
@@ -192,9 +213,9 @@ def using_threads(count: int | None) -> Iterator[int]:
 
     Examples
     --------
-    >>> with using_threads(3) as n:
+    >>> with using_threads(1) as n:
     ...     n, current_threads()
-    (3, 3)
+    (1, 1)
     """
     if count is not None and (isinstance(count, bool) or not isinstance(count, int)
                               or count < 1):

@@ -16,8 +16,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ..runtime.errors import unknown_key
+from ..runtime.errors import excerpt, unknown_key
 from ..runtime.numbers import spelled, whole
+from ..runtime.parallel import thread_count
 from ..runtime.warning_codes import parse_codes, parse_level
 from .drivers import ACCEL_DRIVERS
 from .local_step import METHODS
@@ -88,6 +89,12 @@ class Setting:
                 return parse_size(value)
             except ValueError as exc:
                 raise error(f"{self.name} {exc}") from None
+        if self.kind == "count":  # one reading for the option, the variable, the key
+            count = thread_count(value)
+            if count is None:
+                raise error(f"{self.name} must be a positive whole number (digits), got "
+                            f"{excerpt(repr(value))}")
+            return count
         out: float
         value = spelled(value)
         if self.kind == "int":
@@ -150,7 +157,7 @@ SETTINGS = (
             "First iterate: the handles' rotations spread harmonically (harmonic) or identity "
             "rotors (laplacian editing).", "solve",
             choices=tuple(k for k in STARTS if k not in WARM_STARTS)),
-    Setting("threads", "int", None,
+    Setting("threads", "count", None,
             "Threads for one solve; any count gives byte-identical results (batch divides "
             "the CPUs among its workers).", "solve", minimum=1, metavar="N",
             default_text="$SRARAP_THREADS, else the CPUs this process may use"),

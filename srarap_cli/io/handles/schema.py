@@ -76,6 +76,8 @@ def _keyframe():
 def _setting(s):
     kinds: dict[str, dict[str, Any]] = {
         "float": {"type": "number"}, "int": {"type": "integer"},
+        "count": {"oneOf": [{"type": "integer", "minimum": 1},
+                            {"type": "string", "pattern": r"^\s*[0-9]+\s*$"}]},
         "level": {"enum": [True, False, *s.choices]},
         "codes": {"oneOf": [{"enum": list(CODES)},
                             {"type": "array", "items": {"enum": list(CODES)}}]},
