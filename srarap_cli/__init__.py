@@ -23,7 +23,10 @@ _WHERE = {"Comparison": "tasks.comparison", "CompareJob": "tasks.comparison",
           "deform": "tasks.api", "deform_mesh": "tasks.pipeline", "load_handles": "io.handles",
           "make_deformer": "solver.oneshot", "read_mesh": "io.mesh",
           "register_format": "io.mesh.formats", "resolve": "solver.settings",
-          "run_compare": "tasks.comparison", "write_mesh": "io.mesh"}
+          "run_compare": "tasks.comparison", "write_mesh": "io.mesh",
+          "RenderJob": "tasks.pictures", "run_render": "tasks.pictures",
+          "PlotJob": "tasks.pictures", "run_plot": "tasks.pictures",
+          "BenchJob": "tasks.bench", "run_bench": "tasks.bench"}
 
 __all__ = sorted(_WHERE)
 

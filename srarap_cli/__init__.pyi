@@ -18,10 +18,16 @@ from .solver.settings import Settings as Settings
 from .solver.settings import resolve as resolve
 from .solver.stop import StopReason as StopReason
 from .tasks.api import deform as deform
+from .tasks.bench import BenchJob as BenchJob
+from .tasks.bench import run_bench as run_bench
 from .tasks.comparison import CompareJob as CompareJob
 from .tasks.comparison import Comparison as Comparison
 from .tasks.comparison import compare_meshes as compare_meshes
 from .tasks.comparison import run_compare as run_compare
+from .tasks.pictures import PlotJob as PlotJob
+from .tasks.pictures import RenderJob as RenderJob
+from .tasks.pictures import run_plot as run_plot
+from .tasks.pictures import run_render as run_render
 from .tasks.pipeline import deform_mesh as deform_mesh
 
 __version__: str

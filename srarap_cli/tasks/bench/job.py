@@ -13,6 +13,7 @@ from ...runtime.encoding import utf8
 from ...runtime.errors import UsageProblem
 from ...runtime.limits import check_solve
 from ...solver.settings import resolve
+from .. import job_fields as fields
 from ..pipeline import problem
 from ..preflight import check_output_path, refuse_overwrite
 from .methods import ALL_METHODS, IGL, run_methods
@@ -38,10 +39,20 @@ class BenchJob:
     out: str | None = None
     settings: Mapping[str, Any] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        fields.text(self, "mesh")
+        fields.text(self, "handles")
+        fields.text(self, "out", optional=True)
+        fields.texts(self, "methods")
+        fields.number(self, "time_budget", 0.0, low_open=True)
+        if not isinstance(self.settings, Mapping):
+            raise TypeError("BenchJob.settings must be a mapping of settings")
+
 
 def run_bench(job: BenchJob, on_table: Callable[[str], None] | None = None) -> list[Any]:
     """Run ``job``; ``on_table`` hears the results table as soon as it is made (before the
     files). Returns the runs."""
+    fields.of_type(job, BenchJob, "run_bench")
     unknown = [m for m in job.methods if m not in CHOICES]
     if unknown or not job.methods:
         raise UsageProblem(f"--methods: unknown method {unknown[0] if unknown else '(none)'!r}; "

@@ -12,13 +12,14 @@ from ...runtime import exit_codes
 from ...runtime.commit import commit_files
 from ...runtime.encoding import utf8
 from ...runtime.errors import InputError, UsageProblem
+from .. import job_fields as fields
 from ..ci_summaries import openmetrics, summary_markdown
 from ..job_status import JobResult, JobStatus
 from ..pictures import difference_picture, shape_picture
 from ..preflight import check_output_path, read_any_mesh, refuse_overwrite
 from ..reports import encode_png, junit_xml, report_html
 from .align import moved
-from .compare import Comparison, Verdict, compare_meshes
+from .compare import ALIGNMENTS, Comparison, Verdict, compare_meshes
 from .gates import Expect, Observed, judge, verdict_line
 from .goldens import write_golden
 
@@ -49,6 +50,19 @@ class CompareJob:
     goldens: str = "check"
     summary_md: str | None = None
     metrics: str | None = None
+
+    def __post_init__(self) -> None:
+        fields.text(self, "a")
+        fields.text(self, "b")
+        for name in ("json", "report", "junit", "summary_md", "metrics"):
+            fields.text(self, name, optional=True)
+        fields.number(self, "tol")
+        fields.flag(self, "relative")
+        fields.number(self, "beyond_tol", high=1.0)
+        fields.number(self, "p95", optional=True)
+        fields.number(self, "p99", optional=True)
+        fields.choice(self, "align", ALIGNMENTS)
+        fields.choice(self, "goldens", ("check", "update", "accept"))
 
     def expect(self) -> Expect:
         return Expect(self.b, self.tol, self.relative, self.beyond_tol, self.p95, self.p99,
@@ -111,6 +125,7 @@ _IN_FRONT = ("mode", "max", "mean", "rms", "diagonal", "farthest")
 def run_compare(job: CompareJob) -> CompareOutcome:
     """Compare ``job``'s meshes, write B from A where ``job.goldens`` says so, and commit the
     files it asks for (all or none)."""
+    fields.of_type(job, CompareJob, "run_compare")
     _check(job)
     ma = read_any_mesh(job.a, job.input_format)[0]
     if job.goldens != "check" and job.b != "-" and not os.path.exists(job.b):

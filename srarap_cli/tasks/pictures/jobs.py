@@ -14,6 +14,7 @@ from ...io.mesh.formats import MeshFormat
 from ...io.solve_log import read_log
 from ...runtime.commit import commit_files
 from ...runtime.errors import InputError, UsageProblem
+from .. import job_fields as fields
 from ..animate import frame_paths
 from ..info import up_axis, up_decided
 from ..preflight import check_output_path, read_any_mesh, refuse_overwrite
@@ -25,6 +26,9 @@ from .render import VIEWS
 #: frames of an animated GIF at most (each one a picture held until the file is encoded); a
 #: contact sheet draws 24 of any number
 MAX_GIF_FRAMES = 10_000
+#: what ``render`` takes: colourings, layouts, the axis drawn upward
+COLORS, LAYOUTS = ("shade", "distortion"), ("ghost", "side")
+UPS = ("auto", "y", "z", "x", "-y", "-z", "-x")
 #: what ``--up auto`` says when the extents do not tell
 UP_NOTE = ("srarap: note: drawn with +y up: the mesh's extents do not tell which axis is up "
            "(most OBJ and PLY files are y-up); --up z if it stands on z")
@@ -71,10 +75,21 @@ class RenderJob:
     fps: float = 12.0
     input_format: MeshFormat | None = None
 
+    def __post_init__(self) -> None:
+        for name, optional in (("mesh", False), ("out", False), ("handles", True),
+                               ("rest", True), ("size", True)):
+            fields.text(self, name, optional)
+        fields.choice(self, "color", COLORS)
+        fields.choice(self, "layout", LAYOUTS)
+        fields.choice(self, "up", UPS)
+        fields.texts(self, "views")
+        fields.number(self, "fps", 1.0, 50.0)
+
 
 def run_render(job: RenderJob, on_note: Callable[[str], None] | None = None) -> str:
     """Draw ``job``; ``on_note`` hears the line ``--up auto`` says when it guesses y.
     Returns the file written."""
+    fields.of_type(job, RenderJob, "run_render")
     if "{" in job.mesh:
         _frames(job, on_note)
         return job.out
@@ -144,9 +159,15 @@ class PlotJob:
     out: str
     size: str = "1000x420"
 
+    def __post_init__(self) -> None:
+        fields.texts(self, "logs")
+        fields.text(self, "out")
+        fields.text(self, "size")
+
 
 def run_plot(job: PlotJob) -> str:
     """Plot ``job``; returns the file written."""
+    fields.of_type(job, PlotJob, "run_plot")
     check_output_path(job.out, (".png",), "output")
     refuse_overwrite([job.out], others=[("log", path) for path in job.logs])
     w, h = pixel_size(job.size)
