@@ -95,3 +95,26 @@ def test_a_sel_file_from_a_stream_is_refused_with_its_reason(tmp_path):
     done = _deform(tmp_path, str(fifo), "out.obj")  # refused before the FIFO is opened
     err = done.stderr.decode()
     assert done.returncode == 4 and ".def" in err and err.count("\n") == 1, err
+
+
+def test_a_handle_file_on_standard_input_waits_for_its_writer_as_a_fifo_does(tmp_path):
+    """Issue 71 (HANG-4): ``-`` as the handle file waited for its writer without bound; the
+    line says the time it really waited."""
+    import subprocess
+    import sys
+
+    from helpers import ROOT
+    code = ("import sys; import srarap_cli.io.documents as d; d.STREAM_WAIT = 1.0\n"
+            "from srarap_cli.cli import main\n"
+            f"sys.argv = ['srarap', 'deform', {ROOT + '/sample_meshes/bar.obj'!r}, '-', '-o',"
+            f" {str(tmp_path / 'o.obj')!r}]\nmain()\n")
+    p = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    try:  # the writer (this test) holds the pipe open and sends nothing
+        p.wait(timeout=120)
+        err = p.stderr.read()
+    finally:
+        p.kill()
+        p.stdin.close()
+    assert p.returncode == 4 and "<stdin>: nothing came through it in 1 s" in err, err
+    assert not (tmp_path / "o.obj").exists()

@@ -11,6 +11,7 @@ import os
 import select
 import stat
 import sys
+import time
 from typing import Any
 
 import yaml
@@ -121,7 +122,8 @@ def _read_stream(path):
         if path == "-":
             if sys.stdin is None or sys.stdin.closed:
                 raise InputError("<stdin>: standard input is closed; give a file instead of '-'")
-            data = sys.stdin.buffer.read(MAX_BYTES + 1)
+            fd = _descriptor(sys.stdin)
+            data = sys.stdin.buffer.read(MAX_BYTES + 1) if fd is None else _read_fd(fd, name)
         else:
             data = _read_pipe(path, name)
     except OSError as exc:
@@ -137,24 +139,44 @@ def _read_pipe(path, name):
     polled (on Linux a FIFO is not readable until a writer sends or closes)."""
     fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     try:
-        poller = select.poll()
-        poller.register(fd, select.POLLIN)
-        chunks, total = [], 0
-        while total <= MAX_BYTES:
-            if not poller.poll(int(STREAM_WAIT * 1000)):
-                raise InputError(f"{name}: nothing came through it in {STREAM_WAIT:g} s (a "
-                                 "pipe nobody writes to?); give a file")
-            try:
-                chunk = os.read(fd, 1 << 20)
-            except BlockingIOError:
-                continue
-            if not chunk:
-                break
-            chunks.append(chunk)
-            total += len(chunk)
-        return b"".join(chunks)
+        return _read_fd(fd, name)
     finally:
         os.close(fd)
+
+
+def _descriptor(stream):
+    """The descriptor behind ``stream``, or None (a host running commands in-process gives
+    a stream in memory)."""
+    try:
+        return stream.fileno()
+    except (AttributeError, OSError, ValueError):
+        return None
+
+
+def _read_fd(fd, name):
+    """At most MAX_BYTES and one byte from ``fd``, giving up when nothing has come for
+    STREAM_WAIT seconds, the time said as it was measured (standard input waits for its
+    writer as a FIFO does)."""
+    poller = select.poll()
+    poller.register(fd, select.POLLIN)
+    chunks, total, since = [], 0, time.monotonic()
+    while total <= MAX_BYTES:
+        left = STREAM_WAIT - (time.monotonic() - since)
+        if left <= 0 or not poller.poll(int(left * 1000) + 1):
+            raise InputError(f"{name}: nothing came through it in "
+                             f"{time.monotonic() - since:.0f} s (a pipe nobody writes to?); "
+                             "give a file")
+        try:
+            chunk = os.read(fd, 1 << 20)
+        except BlockingIOError:
+            time.sleep(0.01)  # readable for poll, not yet for read (a FIFO with no writer)
+            continue
+        if not chunk:
+            break
+        chunks.append(chunk)
+        total += len(chunk)
+        since = time.monotonic()
+    return b"".join(chunks)
 
 
 def _reason(exc):
