@@ -199,9 +199,11 @@ class Tolerance(click.ParamType):
         try:
             number = float(text.removesuffix("%").strip())
         except ValueError:
-            number = math.nan
-        if not (math.isfinite(number) and number >= 0):
             self.fail(f"{value!r} is neither a number >= 0 nor a percentage (1%)", param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        if number < 0:
+            self.fail(f"{value!r} is below 0", param, ctx)
         return (number / 100, True) if percent else (number, False)
 
 
