@@ -2,6 +2,7 @@
 (YAML or JSON), as meshes are: the same bytes out as from the file itself (issue 60)."""
 import json
 import os
+import re
 import subprocess
 import sys
 import threading
@@ -116,5 +117,7 @@ def test_a_handle_file_on_standard_input_waits_for_its_writer_as_a_fifo_does(tmp
     finally:
         p.kill()
         p.stdin.close()
-    assert p.returncode == 4 and "<stdin>: nothing came through it in 1 s" in err, err
+    # the time as measured, to a tenth: a loaded machine may say 1.1
+    assert p.returncode == 4 and re.search(r"<stdin>: nothing came through it in 1(\.\d)? s",
+                                           err), err
     assert not (tmp_path / "o.obj").exists()

@@ -1,5 +1,6 @@
 """Hostile input: no crash, no hang, no blow-up, one InputError naming the file."""
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -99,7 +100,7 @@ def test_ascii_ply_with_extra_vertex_properties_reads(tmp_path):
     ("mesh.obj", "not a regular file"), ("mesh.ply", "not a regular file"),
     # a handle file is read from a pipe by its content (issue 60): one nobody writes to is
     # given up after the wait (0.5 s here), a .sel before it is opened
-    ("handles.yaml", "nothing came through it in 0.5 s"), ("handles.sel", "beside its .def")])
+    ("handles.yaml", r"nothing came through it in 0\.[5-9] s"), ("handles.sel", "beside its .def")])
 def test_a_fifo_or_device_nobody_writes_to_ends_in_one_line_without_blocking(tmp_path, kind,
                                                                              says):
     fifo = tmp_path / kind
@@ -115,7 +116,7 @@ def test_a_fifo_or_device_nobody_writes_to_ends_in_one_line_without_blocking(tmp
             "except InputError as e: print(e)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=60).stdout
-    assert says in out
+    assert re.search(says, out), out  # the wait as measured: a loaded machine adds a tenth
     with pytest.raises(InputError, match="not a regular file"):
         read_mesh(_link(tmp_path, "/dev/zero"))  # a device behind a symlink
 

@@ -164,8 +164,8 @@ def _read_fd(fd, name):
         left = STREAM_WAIT - (time.monotonic() - since)
         if left <= 0 or not poller.poll(int(left * 1000) + 1):
             raise InputError(f"{name}: nothing came through it in "
-                             f"{time.monotonic() - since:.0f} s (a pipe nobody writes to?); "
-                             "give a file")
+                             f"{round(time.monotonic() - since, 1):g} s (a pipe nobody writes "
+                             "to?); give a file")
         try:
             chunk = os.read(fd, 1 << 20)
         except BlockingIOError:
