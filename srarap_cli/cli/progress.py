@@ -54,8 +54,11 @@ class SolveProgress:
         self.last_row = -float("inf")  # when the solve last sent a row (they say its state)
         self._lock = threading.Lock()
         self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
         if enabled:
-            threading.Thread(target=self._beat, name="srarap-heartbeat", daemon=True).start()
+            self._thread = threading.Thread(target=self._beat, name="srarap-heartbeat",
+                                            daemon=True)
+            self._thread.start()
 
     def _beat(self) -> None:
         """While no row said anything for an interval, name the stages running."""
@@ -64,7 +67,7 @@ class SolveProgress:
             if now < self.delay or now - max(self.last, self.last_row) < self.every:
                 continue
             busy = stages.running()
-            if busy:
+            if busy and not self._stop.is_set():
                 self._show("; ".join(f"{name} {seconds:.1f} s" for name, seconds in busy)
                            + f"  ({now:.1f} s in all)")
 
@@ -101,6 +104,8 @@ class SolveProgress:
 
     def close(self) -> None:
         self._stop.set()
+        if self._thread is not None:  # nothing of it may reach a stream its caller closes
+            self._thread.join(timeout=5.0)
         if self.shown and self.terminal:
             sys.stderr.write("\r\033[K")
             sys.stderr.flush()
