@@ -41,8 +41,8 @@ def outcome(result):
     return result.parseoutcomes()
 
 
-@pytest.mark.parametrize("workers", [[], pytest.param(["-n", "2"], marks=pytest.mark.slow)],
-                         ids=["plain", "xdist"])
+@pytest.mark.slow  # eight pytest runs in processes of their own (about 10 s)
+@pytest.mark.parametrize("workers", [[], ["-n", "2"]], ids=["plain", "xdist"])
 def test_create_pass_fail_on_change_and_rebaseline(project, workers, monkeypatch):
     args = ["-p", "no:cacheprovider", *workers]
     golden = project.path / "test_meshes"

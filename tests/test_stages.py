@@ -2,6 +2,8 @@
 them in a log while nothing else is said (``cli/progress.py``)."""
 import time
 
+import pytest
+
 from srarap_cli.cli.progress import SolveProgress
 from srarap_cli.runtime import stages
 
@@ -52,6 +54,7 @@ def test_quiet_has_no_heartbeat(capsys, monkeypatch):
     assert capsys.readouterr().err == ""
 
 
+@pytest.mark.slow  # three batches in processes of their own
 def test_a_batch_log_names_each_long_jobs_stages_in_process_and_in_workers(tmp_path):
     import json
     import os

@@ -10,7 +10,7 @@ import math
 from collections.abc import Callable, Sequence
 
 from .job_status import JobResult
-from .reports import ordered
+from .reports import number_text, ordered, percent_text
 
 #: name -> (help, unit or "", the figure of a result); one sample per job and metric, NaN
 #: where a job has no such figure (it failed before solving, it has no golden)
@@ -36,13 +36,13 @@ _COLUMNS: tuple[tuple[str, str, Callable[[JobResult], str]], ...] = (
     ("status", "---", lambda r: f"**{r.status.value}**" if not r.status.passed
      else r.status.value),
     ("golden", "---", lambda r: r.golden or "-"),
-    ("iterations", "--:", lambda r: _figure(r.iterations, "d")),
-    ("seconds", "--:", lambda r: _figure(r.seconds, ".2f")),
-    ("energy", "--:", lambda r: _figure(r.energy, ".4g")),
-    ("max distance", "--:", lambda r: _figure(r.compare_max, ".3g")),
-    ("p95", "--:", lambda r: _figure(r.compare_p95, ".3g")),
-    ("beyond tol", "--:", lambda r: "-" if r.beyond_tol is None else f"{100 * r.beyond_tol:.3g}%"),
-    ("tol", "--:", lambda r: _figure(r.tol, "g")),
+    ("iterations", "--:", lambda r: number_text(r.iterations, "d")),
+    ("seconds", "--:", lambda r: number_text(r.seconds, ".2f")),
+    ("energy", "--:", lambda r: number_text(r.energy, ".4g")),
+    ("max distance", "--:", lambda r: number_text(r.compare_max, ".3g")),
+    ("p95", "--:", lambda r: number_text(r.compare_p95, ".3g")),
+    ("beyond tol", "--:", lambda r: percent_text(r.beyond_tol)),
+    ("tol", "--:", lambda r: number_text(r.tol, "g")),
     ("warnings", "--:", lambda r: str(len(r.warnings))),
     ("message", "---", lambda r: _text(r.message) if r.message else ""),
 )
@@ -88,11 +88,6 @@ def _text(text: str) -> str:
     """A name or message as one table cell: markup escaped, lines joined."""
     flat = " ".join(str(text).split())
     return "".join("\\" + c if c in _MARKUP else c for c in flat)
-
-
-def _figure(value, fmt):
-    return "-" if value is None or (isinstance(value, float) and math.isnan(value)) \
-        else format(value, fmt)
 
 
 def _label(text: str) -> str:

@@ -43,14 +43,20 @@ def ordered(rows: Sequence[JobResult]) -> list[JobResult]:
     return sorted(rows, key=lambda r: rank[r.status])
 
 
-def _number(value, fmt):
+def number_text(value: float | int | None, fmt: str) -> str:
+    """A figure as a report shows it: ``-`` where there is none (None, NaN)."""
     return "-" if value is None or (isinstance(value, float) and math.isnan(value)) \
         else format(value, fmt)
 
 
+def percent_text(fraction: float | None) -> str:
+    """A fraction as a percentage (``12%``), ``-`` where there is none."""
+    return "-" if fraction is None else f"{100 * fraction:.3g}%"
+
+
 def _seconds(value, fmt=".2f"):
     """Measured seconds, marked: the only text two reports of identical inputs differ in."""
-    return f"<span class=\"seconds\">{_number(value, fmt)}</span>"
+    return f"<span class=\"seconds\">{number_text(value, fmt)}</span>"
 
 
 def _summary(rows):
@@ -72,20 +78,20 @@ def _summary(rows):
 
 def _job(row, pictures):
     status = row.status.value
-    numbers = [("exit code", _number(row.exit_code, "d")),
+    numbers = [("exit code", number_text(row.exit_code, "d")),
                ("stop", html.escape(row.stop or "-")),  # from a record: text, not markup
-               ("iterations", _number(row.iterations, "d")),
+               ("iterations", number_text(row.iterations, "d")),
                ("seconds", _seconds(row.seconds)),
-               ("energy", _number(row.energy, ".6g")),
-               ("to golden: max", _number(row.compare_max, ".3g")),
-               ("mean", _number(row.compare_mean, ".3g")),
-               ("p95", _number(row.compare_p95, ".3g")),
-               ("p99", _number(row.compare_p99, ".3g")),
-               ("beyond tol", "-" if row.beyond_tol is None else f"{100 * row.beyond_tol:.3g}%"),
-               *([("A to B", _number(row.compare_a_to_b, ".3g")),  # A: the golden
-                  ("B to A", _number(row.compare_b_to_a, ".3g"))]
+               ("energy", number_text(row.energy, ".6g")),
+               ("to golden: max", number_text(row.compare_max, ".3g")),
+               ("mean", number_text(row.compare_mean, ".3g")),
+               ("p95", number_text(row.compare_p95, ".3g")),
+               ("p99", number_text(row.compare_p99, ".3g")),
+               ("beyond tol", percent_text(row.beyond_tol)),
+               *([("A to B", number_text(row.compare_a_to_b, ".3g")),  # A: the golden
+                  ("B to A", number_text(row.compare_b_to_a, ".3g"))]
                  if row.compare_a_to_b is not None else []),
-               ("tolerance", _number(row.tol, "g")),
+               ("tolerance", number_text(row.tol, "g")),
                ("golden", html.escape(row.golden or "-")),
                ("warnings", str(len(row.warnings)))]
     table = ("<tr>" + "".join(f"<th>{k}</th>" for k, _ in numbers) + "</tr><tr>"
@@ -198,14 +204,14 @@ def _detail(row):
     if row.message:
         parts.append(row.message)
     if row.compare_max is not None:
-        beyond = "-" if row.beyond_tol is None else f"{100 * row.beyond_tol:.3g}%"
+        beyond = percent_text(row.beyond_tol)
         parts.append(f"distance to golden: max {row.compare_max:.3g}, mean "
-                     f"{_number(row.compare_mean, '.3g')}, p95 {_number(row.compare_p95, '.3g')}"
-                     f", p99 {_number(row.compare_p99, '.3g')}, beyond tol {beyond}, tol "
-                     f"{_number(row.tol, 'g')}")
+                     f"{number_text(row.compare_mean, '.3g')}, p95 {number_text(row.compare_p95, '.3g')}"
+                     f", p99 {number_text(row.compare_p99, '.3g')}, beyond tol {beyond}, tol "
+                     f"{number_text(row.tol, 'g')}")
     if row.compare_a_to_b is not None:
         parts.append(f"one-sided: A to B max {row.compare_a_to_b:.3g}, B to A max "
-                     f"{_number(row.compare_b_to_a, '.3g')} (at every vertex)")
+                     f"{number_text(row.compare_b_to_a, '.3g')} (at every vertex)")
     if row.aligned:
         parts.append(f"aligned first: {row.aligned}")
     if row.golden:
