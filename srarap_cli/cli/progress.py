@@ -52,6 +52,7 @@ class SolveProgress:
         self.shown = False
         self.levels = False  # a row named its level: the solve has a coarse mesh
         self.last_row = -float("inf")  # when the solve last sent a row (they say its state)
+        self.row_shown = -float("inf")  # when a row was last shown: a heartbeat never delays one
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -76,9 +77,9 @@ class SolveProgress:
             return
         self.levels = self.levels or "level" in row
         now = self.last_row = time.perf_counter() - self.start
-        if now < self.delay or now - self.last < self.every:
+        if now < self.delay or now - self.row_shown < self.every:
             return
-        self.last, self.shown = now, True
+        self.row_shown = now
         level = f"{row.get('level', 'full resolution')}, " if self.levels else ""
         self._show(f"{level}iteration {row['iteration']}  energy {row['total']:.6g}  "
                    f"change {row['rel_change']:.2g}  {now:.1f} s")
@@ -95,8 +96,9 @@ class SolveProgress:
     def say(self, line: str) -> None:
         """Print ``line`` on stderr, on a terminal over the progress line (redrawn at the next
         row), so that the two never share a line."""
-        sys.stderr.write(("\r\033[K" if self.shown and self.terminal else "") + line + "\n")
-        sys.stderr.flush()
+        with self._lock:  # never inside a heartbeat's line
+            sys.stderr.write(("\r\033[K" if self.shown and self.terminal else "") + line + "\n")
+            sys.stderr.flush()
 
     def stage(self, name: str, seconds: float) -> None:
         """A stage's ``-v`` line, as it ends (see :mod:`srarap_cli.runtime.stages`)."""
