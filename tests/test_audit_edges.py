@@ -630,3 +630,34 @@ def test_two_spellings_of_one_key_are_refused_by_value(tmp_path, first, second, 
         r = run_cli(command)
         assert r.returncode == 4 and words in r.stderr, r.stderr
         assert len(r.stderr.splitlines()) == 1 and not (tmp_path / "o.obj").exists()
+
+
+DIGITS = "1" * 5000
+
+
+@pytest.mark.parametrize("where, args, code, env", [
+    ("yaml", ["info", BAR, "{doc}.yaml"], 4, {}),
+    ("json", ["info", BAR, "{doc}.json"], 4, {}),
+    ("option", ["deform", BAR, TWIST, "-o", "o.obj", "--max-iter", DIGITS], 2, {}),
+    ("multires", ["deform", BAR, TWIST, "-o", "o.obj", "--multires", DIGITS, "-q"], 0, {}),
+    ("threads", ["deform", BAR, TWIST, "-o", "o.obj", "--threads", DIGITS, "-q"], 0, {}),
+    ("variable", ["info", BAR], 0, {"SRARAP_THREADS": DIGITS})])
+def test_a_number_of_thousands_of_digits_is_read_or_refused_in_our_words(tmp_path, monkeypatch,
+                                                                         where, args, code,
+                                                                         env):
+    """Issue 71 (MSG-4): a 5000-digit integer gave Python's advice to raise
+    sys.set_int_max_str_digits(), or an internal error (exit 1) for a thread count. A count
+    that large is a count like any large one (capped); elsewhere it is refused, in one
+    short line."""
+    doc = tmp_path / "h"
+    (tmp_path / "h.yaml").write_text(f"groups:\n  a: {{indices: [{DIGITS}], fixed: true}}\n")
+    (tmp_path / "h.json").write_text(json.dumps({"groups": {"a": {"fixed": True}}})
+                                     .replace('"fixed"', f'"indices": [{DIGITS}], "fixed"'))
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    r = run_cli([a.format(doc=doc) for a in args], cwd=tmp_path)
+    assert r.returncode == code, r.stderr
+    assert "set_int_max_str_digits" not in r.stderr and "Traceback" not in r.stderr
+    assert all(len(line) < 300 for line in r.stderr.splitlines())
+    if code == 4:
+        assert "a number of 5000 digits" in one_line(r, 4)

@@ -196,3 +196,36 @@ def test_the_dry_run_warns_what_deform_warns_on_a_mesh_of_several_parts(tmp_path
     assert said == set(doc["warnings"]) | set(doc["problems"])
     assert any("move each rigidly" in w for w in said)
     assert any("without a constrained vertex" in w for w in said)
+
+
+def test_info_passes_over_the_edges_once(monkeypatch):
+    """Issue 70: info took three passes over the edges (parts, loops, Euler) besides the
+    mesh checks' own. A blow-up guard that counts work: one pass for a clean mesh, and
+    the facts it gives are those of the separate passes."""
+    from srarap_cli.solver import mesh_checks
+    from srarap_cli.tasks import info
+    m = tube_mesh(rings=8, segments=10)
+    before = mesh_info(m)
+    calls = []
+    real = mesh_checks.edge_counts
+
+    def counted(F):
+        calls.append(len(F))
+        return real(F)
+    monkeypatch.setattr(mesh_checks, "edge_counts", counted)
+    monkeypatch.setattr(info, "edge_counts", counted)
+    assert mesh_info(m) == before and len(calls) == 1
+    assert (before["components"], before["boundary_loops"], before["genus"]) == (1, 0, 0)
+
+
+def test_describe_gives_the_mesh_and_the_handles_alike_at_one_and_two_threads():
+    from srarap_cli.runtime.parallel import using_threads
+    from srarap_cli.tasks.info import describe, handles_info
+    m = tube_mesh(rings=8, segments=10)
+    c = parse_handles({"groups": {"base": {"indices": [0, 1, 2], "fixed": True},
+                                  "top": {"indices": [80, 81], "translate": [0, 0, 1]}}},
+                      m.vertices)
+    for threads in (1, 2):
+        with using_threads(threads):
+            assert describe(m, c, "m") == (mesh_info(m), handles_info(m, c, "m"))
+            assert describe(m) == (mesh_info(m), None)

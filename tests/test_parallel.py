@@ -79,6 +79,24 @@ def test_a_bad_srarap_threads_is_one_line_and_exit_4(tmp_path):
     assert not (tmp_path / "o.obj").exists()
 
 
+@pytest.mark.parametrize("args", [["info", "{bar}"], ["render", "{bar}", "-o", "p.png"],
+                                  ["compare", "{bar}", "{bar}"], ["samples", "s"],
+                                  ["bench", "{bar}", "{twist}"]])
+def test_every_command_refuses_a_bad_srarap_threads_alike(tmp_path, monkeypatch, args):
+    """Issue 71: render, info and compare ignored the variable that deform refused."""
+    from click.testing import CliRunner
+
+    from srarap_cli.cli import main
+    monkeypatch.setenv(parallel.ENV, "1_0")
+    files = {"bar": os.path.join(ROOT, "sample_meshes", "bar.obj"),
+             "twist": os.path.join(ROOT, "configs", "bar-twist.yaml")}
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(main, [a.format(**files) for a in args])
+    assert r.exit_code == 4 and r.stderr == "srarap: error: SRARAP_THREADS='1_0': expected " \
+        "a positive whole number of threads\n"
+    assert not os.listdir(tmp_path)
+
+
 def test_threads_zero_is_a_usage_error(tmp_path):
     ran = run_cli(["deform", os.path.join(ROOT, "sample_meshes", "bar.obj"),
                    os.path.join(ROOT, "configs", "bar-twist.yaml"), "-o", "o.obj",

@@ -189,7 +189,7 @@ def test_the_reduced_picture_looks_like_the_full_one(tmp_path, monkeypatch):
     from srarap_cli.tasks.pictures import render
 
     V, F = _dense_tube(rings=240, segments=120)
-    colors = render.face_colors(F, [np.flatnonzero(V[:, 2] < 0.5)])
+    V, F, colors = render.group_colors(V, F, [np.flatnonzero(V[:, 2] < 0.5)])
     drawn = []
     real = render.draw
     monkeypatch.setattr(render, "draw", lambda ax, V, F, *a: drawn.append(len(F)) or
@@ -218,3 +218,59 @@ def test_render_is_quiet_with_q_and_says_where_a_gif_comes_from(tmp_path):
     assert (tmp_path / "a.png").read_bytes() == (tmp_path / "b.png").read_bytes()
     r = CliRunner().invoke(main, ["render", BAR, "-o", str(tmp_path / "x.gif")])
     assert r.exit_code == 2 and "frame pattern" in r.stderr and ".png" in r.stderr
+
+
+def _painted_area(V, F, colors, rgb):
+    W = V
+    area = 0.5 * np.linalg.norm(np.cross(W[F[:, 1]] - W[F[:, 0]], W[F[:, 2]] - W[F[:, 0]]),
+                                axis=1)
+    return area[(colors == rgb).all(axis=1)].sum() / area.sum()
+
+
+@pytest.mark.parametrize("selected, painted", [([0], 0.25), ([0, 1], 0.75), ([0, 1, 2], 1.0),
+                                               ([], 0.0)])
+def test_a_group_is_painted_where_its_interpolated_membership_reaches_one_half(selected,
+                                                                              painted):
+    """Issue 70: a face with any selected corner was painted whole, so a long CAD triangle
+    with one selected corner showed a selection far larger than it is. The region where the
+    linear interpolation of a group's membership is at least 1/2 covers a quarter of a
+    triangle with one member corner and three quarters with two."""
+    from srarap_cli.tasks.pictures.render import BASE, group_colors
+    V = np.array([[0.0, 0, 0], [40, 1, 0], [3, 9, 0]])  # any shape: areas scale alike
+    W, G, c = group_colors(V, np.array([[0, 1, 2]]), [np.array(selected, dtype=int)])
+    assert np.isclose(_painted_area(W, G, c, PALETTE[0]), painted)
+    assert np.isclose(_painted_area(W, G, c, BASE), 1 - painted)
+    n = np.cross(W[G[:, 1]] - W[G[:, 0]], W[G[:, 2]] - W[G[:, 0]])
+    assert (n[:, 2] > 0).all()  # the pieces keep the face's orientation (its shading)
+
+
+def test_three_groups_meeting_in_a_face_paint_its_corners_and_leave_its_middle_grey():
+    from srarap_cli.tasks.pictures.render import BASE, group_colors
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    F = np.array([[0, 1, 2], [1, 3, 2]])
+    groups = [np.array([0]), np.array([1, 3]), np.array([2, 3])]  # 3 in two: the last wins
+    W, G, c = group_colors(V, F, groups)
+    # face 0: corners 0, 1, 2 in groups 0, 1, 2, middle grey; face 1: corners 1 (group 1),
+    # 3 and 2 (group 2): corner 1 and the middle (two corners in group 2) coloured
+    assert np.isclose(_painted_area(W, G, c, PALETTE[0]), 0.125)
+    assert np.isclose(_painted_area(W, G, c, PALETTE[1]), 0.25)
+    assert np.isclose(_painted_area(W, G, c, PALETTE[2]), 0.125 + 0.375)
+    assert np.isclose(_painted_area(W, G, c, BASE), 0.125)
+
+
+def test_a_selected_corner_of_long_triangles_is_drawn_as_small_as_it_is(tmp_path):
+    """The picture, seen from above: a 10 x 10 square of two triangles, one corner selected,
+    coloured over a quarter of the square (before: half of it, a whole triangle)."""
+    square = tmp_path / "square.obj"
+    square.write_text("v 0 0 0\nv 10 0 0\nv 10 10 0\nv 0 10 0\nf 1 2 3\nf 1 3 4\n")
+    handles = tmp_path / "corner.yaml"
+    handles.write_text("groups:\n  corner: {indices: [0], fixed: true}\n"
+                       "  far: {indices: [2], translate: [0, 0, 0.001]}\n")
+    out = tmp_path / "p.png"
+    r = invoke("render", square, "--handles", handles, "--view", "top", "--up", "z",
+               "--size", "400x400", "-o", out)
+    assert r.exit_code == 0, r.output
+    img = picture(out)
+    shape = img[..., :3].min(axis=-1) < 0.99
+    red, blue = near(img, PALETTE[0], 0.3) & shape, near(img, PALETTE[1], 0.3) & shape
+    assert 0.2 < red.sum() / shape.sum() < 0.3 and 0.2 < blue.sum() / shape.sum() < 0.3

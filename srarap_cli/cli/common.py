@@ -16,6 +16,7 @@ from ..runtime import descriptors, exit_codes, signals, streams
 from ..runtime.commit import COMMITTED
 from ..runtime.errors import OutputError
 from ..runtime.failures import classify
+from ..runtime.parallel import default_threads
 from ..runtime.signals import Terminated
 
 
@@ -85,6 +86,7 @@ def guarded(func: Callable[..., None]) -> Callable[..., None]:
             # non-finite results are detected and reported as numerical failures; numpy's own
             # floating-point warnings would only add multi-line noise to stderr
             with signals.routed(), np.errstate(all="ignore"):
+                default_threads()  # a bad $SRARAP_THREADS: the same line in every command
                 return func(*args, **kwargs)
         except (click.exceptions.Exit, click.ClickException, SystemExit):
             raise

@@ -11,7 +11,7 @@ from click.core import Command, Context
 from click.formatting import HelpFormatter
 
 from ..runtime import descriptors, exit_codes, limits, signals, streams
-from ..runtime.errors import InputError
+from ..runtime.errors import InputError, plain
 from ..runtime.lazy_modules import defer_unused_numpy_modules
 from ..runtime.threads import pin_process
 from ..runtime.warning_codes import LEVELS
@@ -114,11 +114,12 @@ class LazyGroup(click.Group):
             sys.exit(exit_codes.TERMINATED)
         except click.UsageError as exc:
             where = exc.ctx.command_path if exc.ctx is not None else "srarap"
-            click.echo(f"srarap: error: {exc.format_message()}{usage_hint(exc.format_message())}"
-                       f" (see '{where} --help')", err=True)
+            said = plain(exc.format_message())
+            click.echo(f"srarap: error: {said}{usage_hint(said)} (see '{where} --help')",
+                       err=True)
             sys.exit(exc.exit_code)
         except click.ClickException as exc:
-            click.echo(f"srarap: error: {exc.format_message()}", err=True)
+            click.echo(f"srarap: error: {plain(exc.format_message())}", err=True)
             sys.exit(exc.exit_code)
         except BrokenPipeError:  # --help or --version into a pipe whose reader went away
             descriptors.quiet_stdout()

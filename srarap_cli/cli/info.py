@@ -5,7 +5,7 @@ import click
 
 from ..io.mesh.formats import MeshFormat
 from ..runtime.encoding import utf8
-from ..tasks.info import handles_info, mesh_info
+from ..tasks.info import describe
 from ..tasks.preflight import load_posed, read_any_mesh
 from .common import guarded, input_format_option, pose_options, printable, write_stdout
 
@@ -26,10 +26,11 @@ def info(mesh: str, handles: str | None, input_format: MeshFormat | None,
     """
     source = read_any_mesh(mesh, input_format)[0]
     name = "<stdin>" if mesh == "-" else mesh
-    out = {"mesh": name, **mesh_info(source)}
-    if handles is not None:
-        out["handles"] = handles
-        out.update(handles_info(source, load_posed(handles, source.vertices, fps, frame), name))
+    posed = None if handles is None else load_posed(handles, source.vertices, fps, frame)
+    of_mesh, of_handles = describe(source, posed, name)
+    out = {"mesh": name, **of_mesh}
+    if of_handles is not None:
+        out.update({"handles": handles, **of_handles})
     if as_json:
         write_stdout(utf8(json.dumps(out, indent=2) + "\n"))
     else:

@@ -16,7 +16,7 @@ from typing import Any
 
 import yaml
 
-from ..runtime.errors import InputError
+from ..runtime.errors import InputError, plain
 from .input_files import BOM, read_input_bytes
 
 #: Largest handle file or manifest read, in bytes (real ones are a few KB).
@@ -187,7 +187,7 @@ def _reason(exc):
     if problem:
         return problem + (f" ({context})" if context else "")
     text = str(exc).strip()
-    return text.splitlines()[0] if text else type(exc).__name__
+    return plain(text.splitlines()[0]) if text else type(exc).__name__
 
 
 def _children(node):

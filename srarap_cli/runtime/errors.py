@@ -1,6 +1,14 @@
 """Error types the CLI maps to exit codes; each message is one line naming file and field."""
 import difflib
+import re
 from collections.abc import Iterable
+
+#: CPython's refusal of an integer of too many digits, with its advice to the programmer
+TOO_MANY_DIGITS = re.compile(r"Exceeds the limit \((\d+) digits\) for integer string "
+                             r"conversion[^;]*?: value has (\d+) digits; use "
+                             r"sys\.set_int_max_str_digits\(\) to increase the limit")
+#: a value a library quotes back, too long for one line of ours
+LONG_QUOTE = re.compile(r"'([^'\n]{61,})'")
 
 
 class InputError(ValueError):
@@ -49,3 +57,20 @@ def excerpt(text: object, limit: int = 40) -> str:
     """
     text = "".join(c if c.isprintable() else "?" for c in str(text))
     return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def plain(message: str) -> str:
+    """A library's ``message`` fit for one line of ours: a number of too many digits said as
+    that (not as Python's advice to raise a limit), a value quoted back cut to 60 characters.
+
+    Examples
+    --------
+    >>> plain("Exceeds the limit (4300 digits) for integer string conversion: value has "
+    ...       "5000 digits; use sys.set_int_max_str_digits() to increase the limit")
+    'a number of 5000 digits (at most 4300)'
+    >>> plain("'" + "1" * 500 + "' is not a valid integer")
+    "'11111111111111111111111111111111111111111111111111111111...' is not a valid integer"
+    """
+    message = TOO_MANY_DIGITS.sub(lambda m: f"a number of {m[2]} digits (at most {m[1]})",
+                                  message)
+    return LONG_QUOTE.sub(lambda m: repr(excerpt(m[1], 60)), message)

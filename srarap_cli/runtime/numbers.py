@@ -32,3 +32,21 @@ def whole(value: Any) -> Any:
     if isinstance(value, float) and value.is_integer() and abs(value) <= 2 ** 53:
         return int(value)
     return value
+
+
+#: a whole number of more digits than this is beyond any count srarap takes (threads,
+#: vertices): read as this, so that a count is capped as any large one, where Python's
+#: ``int`` would refuse past 4300 digits
+HUGE = 10 ** 18
+
+
+def digits_value(text: str) -> int:
+    """The int an ASCII digit string spells, at most :data:`HUGE`.
+
+    Examples
+    --------
+    >>> digits_value("0012"), digits_value("9" * 5000) == HUGE
+    (12, True)
+    """
+    text = text.lstrip("0") or "0"
+    return int(text) if len(text) <= 18 else HUGE

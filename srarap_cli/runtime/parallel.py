@@ -25,6 +25,7 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, TypeVar
 
 from .errors import InputError
+from .numbers import digits_value
 
 if TYPE_CHECKING:
     import numpy as np
@@ -170,7 +171,7 @@ def thread_count(value: object) -> int | None:
         text = value.strip()
         if not (text.isascii() and text.isdigit()):
             return None
-        value = int(text)
+        value = digits_value(text)  # 5000 digits: a count as large as any, capped alike
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         return None
     return value

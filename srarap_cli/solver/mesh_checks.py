@@ -119,10 +119,12 @@ def edge_counts(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([low, A.indices.astype(np.int64)], axis=1), A.data
 
 
-def mesh_warnings(V: np.ndarray, F: np.ndarray) -> list[str]:
+def mesh_warnings(V: np.ndarray, F: np.ndarray,
+                  edges: tuple[np.ndarray, np.ndarray] | None = None) -> list[str]:
     """Warning lines for duplicate faces, collapsed, zero-area and needle triangles,
     non-manifold edges and vertices, and surfaces cut open at coincident vertices, of a
-    triangle mesh (V (n, 3), F (f, 3)).
+    triangle mesh (V (n, 3), F (f, 3)). ``edges``: :func:`edge_counts` of ``F`` where the
+    caller has it (used when no face is collapsed or repeated, the usual case).
 
     Examples
     --------
@@ -153,9 +155,10 @@ def mesh_warnings(V: np.ndarray, F: np.ndarray) -> list[str]:
         out.append(note("needles", f"{needles} needle faces (an angle under {NEEDLE_DEGREES:g} "
                         "degree); cotangents are capped at 1000 so no edge weight can swamp "
                         "the others"))
-    edges, counts = edge_counts(distinct)  # duplicates said above
-    out.extend(_manifold_warnings(distinct, len(V), counts))
-    out.extend(_unwelded_warnings(V, edges, counts))
+    if edges is None or collapsed or duplicates:
+        edges = edge_counts(distinct)  # duplicates said above
+    out.extend(_manifold_warnings(distinct, len(V), edges[1]))
+    out.extend(_unwelded_warnings(V, *edges))
     return out
 
 

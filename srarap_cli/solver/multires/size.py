@@ -1,6 +1,8 @@
 """How many coarse vertices a multiresolution solve uses: ``off``, ``N``, ``P%`` or auto."""
 import re
 
+from ...runtime.numbers import digits_value
+
 # auto: coarse-to-fine (refine mode) on AUTO_SIZE coarse vertices from AUTO_THRESHOLD
 # vertices on. Measured against the direct solve (default settings, tol 1e-6, setup plus
 # solve): Spot 11.5k 2.2 s either way; a cylinder Loop-subdivided once (19k) 8.7 s direct,
@@ -55,7 +57,7 @@ def parse_size(text: object) -> int | float | str:
         if not re.fullmatch(r"\d+", s):
             raise ValueError("must be off, auto, a vertex count, a percentage like 2% or a "
                              "fraction like 0.02")
-        value = int(s)
+        value = digits_value(s)
     if value < MIN_SIZE:
         raise ValueError(f"a coarse vertex count must be at least {MIN_SIZE}")
     return value

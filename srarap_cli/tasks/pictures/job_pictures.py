@@ -11,7 +11,7 @@ from ...io.mesh.mesh import Mesh
 from ..info import up_axis
 from .log_axis import decades_axis
 from .preview import UP
-from .render import face_colors, render_png
+from .render import face_colors, group_colors, render_png
 
 #: each picture's size in pixels: a report of 100 jobs stays a few megabytes
 THUMBNAIL = (240, 200)
@@ -24,8 +24,9 @@ def shape_picture(rest: Mesh, deformed: Mesh, constraints: Constraints | None) -
     turn = UP[up_axis(rest)].T
     F = deformed.triangles()[0]
     groups = list(constraints.groups.values()) if constraints is not None else None
-    panel = [(rest.vertices @ turn, F, face_colors(F), 0.25),
-             (deformed.vertices @ turn, F, face_colors(F, groups), 1.0)]
+    shape = (group_colors(deformed.vertices @ turn, F, groups) if groups else
+             (deformed.vertices @ turn, F, face_colors(F)))
+    panel = [(rest.vertices @ turn, F, face_colors(F), 0.25), (*shape, 1.0)]
     return render_png([panel], THUMBNAIL, "iso", axes=turn)
 
 

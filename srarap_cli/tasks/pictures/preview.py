@@ -6,7 +6,7 @@ import numpy as np
 from ...io.handles import Constraints
 from ...io.mesh.mesh import Mesh
 from ..distortion import vertex_distortion
-from .render import face_colors, render_png
+from .render import face_colors, group_colors, render_png
 
 #: Proper rotations taking each axis name to +z, the renderer's up.
 UP = {"z": np.eye(3), "-z": np.diag([1.0, -1, -1]),
@@ -34,22 +34,22 @@ def preview_png(mesh: Mesh, rest: Mesh | None = None, constraints: Constraints |
     F = mesh.triangles()[0]
     groups = list(constraints.groups.values()) if constraints is not None else None
     colorbar = None
+    painted = _painter(F, groups)
     if color == "distortion":
         if rest is None:
             raise ValueError("a distortion map needs the rest shape")
         d = vertex_distortion(rest.vertices, mesh.vertices, F)
         vmax = max(float(np.percentile(d, CLIP_PERCENTILE)), 1e-12)
-        colors = face_colors(F, scalar=d, vmax=vmax)
+        current = [(mesh.vertices, F, face_colors(F, scalar=d, vmax=vmax), 1.0)]
         clipped = f", clipped at the {CLIP_PERCENTILE}th percentile (max {d.max():.3g})" \
             if d.max() > vmax else ""
         colorbar = (f"distortion (relative strain){clipped}", vmax)
     else:
-        colors = face_colors(F, groups)
-    current = [(mesh.vertices, F, colors, 1.0)]
+        current = [painted(mesh.vertices)]
     if rest is None:
         panels = [current]
     else:
-        rest_item = (rest.vertices, F, face_colors(F, groups), 1.0)
+        rest_item = painted(rest.vertices)
         panels = [[rest_item], current] if layout == "side" else \
             [[(rest.vertices, F, face_colors(F), 0.25)] + current]
     lo, hi = mesh.vertices.min(axis=0) @ turn.T, mesh.vertices.max(axis=0) @ turn.T
@@ -62,3 +62,10 @@ def preview_png(mesh: Mesh, rest: Mesh | None = None, constraints: Constraints |
     titles = ["rest", "deformed"] if len(panels) == 2 else None
     return render_png(panels, size, view, colorbar, legend=legend, axes=turn, note=note,
                       titles=titles, framed=None if framed is None else framed @ turn)
+
+
+def _painter(F, groups):
+    """(V) -> (V, F, colors, 1.0): the mesh of ``F`` at positions V, groups painted."""
+    if not groups:
+        return lambda V: (V, F, face_colors(F), 1.0)
+    return lambda V: (*group_colors(V, F, groups), 1.0)

@@ -183,20 +183,65 @@ def _triad(fig, left, view, model_axes):
         ax.text(1.15 * x, 1.15 * y, label, color=color, fontsize=7, ha="center", va="center")
 
 
-def face_colors(F: np.ndarray, vertex_groups: Sequence[np.ndarray] | None = None,
-                scalar: np.ndarray | None = None, vmax: float | None = None) -> np.ndarray:
-    """Per-face RGB: base grey, handle groups from the palette, or a viridis scalar."""
-    if scalar is not None:
-        from matplotlib import colormaps
-        values = scalar[F].mean(axis=1) / (vmax if vmax else max(scalar.max(), 1e-300))
-        return colormaps["viridis"](np.clip(values, 0, 1))[:, :3]
-    out = np.tile(BASE, (len(F), 1))
-    if vertex_groups is not None:
-        for k, ids in enumerate(vertex_groups):
-            mark = np.zeros(int(F.max()) + 1, dtype=bool)
-            mark[ids[ids <= F.max()]] = True
-            out[mark[F].any(axis=1)] = PALETTE[k % len(PALETTE)]
-    return out
+def face_colors(F: np.ndarray, scalar: np.ndarray | None = None,
+                vmax: float | None = None) -> np.ndarray:
+    """Per-face RGB (f, 3): base grey, or viridis of the per-vertex ``scalar`` (n,) averaged
+    over each face, over ``[0, vmax]`` (default: the scalar's maximum)."""
+    if scalar is None:
+        return np.tile(BASE, (len(F), 1))
+    from matplotlib import colormaps
+    values = scalar[F].mean(axis=1) / (vmax if vmax else max(scalar.max(), 1e-300))
+    return colormaps["viridis"](np.clip(values, 0, 1))[:, :3]
+
+
+def group_colors(V: np.ndarray, F: np.ndarray, vertex_groups: Sequence[np.ndarray]
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The mesh with each handle group painted where its vertices are: a face whose corners
+    all belong to one group (or none) takes its colour; a face between groups is cut at its
+    edges' midpoints into four, each corner triangle in its corner's colour and the middle
+    one in the colour two corners share (grey if none). So a selection is drawn out to half
+    its edges, as the interpolated membership reads it: a long CAD triangle with one
+    selected corner shows a quarter of it coloured, not all of it, and a selected ring seen
+    edge on still shows a band. A vertex in several groups takes the last one's colour.
+
+    Parameters
+    ----------
+    V : (n, 3) float array; F : (f, 3) int array
+    vertex_groups : sequence of int arrays, vertex ids per group (palette colours in order)
+
+    Returns
+    -------
+    V : (n + 3k, 3) float array, the midpoints of the k cut faces appended;
+    F : (f + 3k, 3) int array; colors : (f + 3k, 3) float array, per face
+
+    Examples
+    --------
+    >>> V = np.array([[0., 0, 0], [4, 0, 0], [0, 4, 0]])
+    >>> W, G, c = group_colors(V, np.array([[0, 1, 2]]), [np.array([0])])
+    >>> len(G), (c == PALETTE[0]).all(axis=1).tolist()
+    (4, [True, False, False, False])
+    """
+    label = np.full(len(V), -1, dtype=np.int64)
+    for k, ids in enumerate(vertex_groups):
+        ids = np.asarray(ids, dtype=np.int64)
+        label[ids[(ids >= 0) & (ids < len(V))]] = k
+    corner = label[F]
+    cut = (corner != corner[:, :1]).any(axis=1)
+    kept, C, L = F[~cut], F[cut], corner[cut]
+    k = len(C)
+    mid = np.arange(3 * k).reshape(k, 3) + len(V)  # midpoints of edges 01, 12, 20
+    W = np.vstack([V, (V[C] + V[C[:, [1, 2, 0]]]).reshape(-1, 3) / 2])
+    pieces = np.concatenate([np.column_stack([C[:, 0], mid[:, 0], mid[:, 2]]),
+                             np.column_stack([mid[:, 0], C[:, 1], mid[:, 1]]),
+                             np.column_stack([mid[:, 2], mid[:, 1], C[:, 2]]),
+                             mid])
+    shared = np.where(L[:, 1] == L[:, 2], L[:, 1], np.where(L[:, 0] == L[:, 1], L[:, 0],
+                                                             np.where(L[:, 0] == L[:, 2],
+                                                                      L[:, 0], -1)))
+    labels = np.concatenate([label[kept[:, 0]], L[:, 0], L[:, 1], L[:, 2], shared])
+    palette = np.vstack([PALETTE, BASE])  # label -1 reads the last row
+    colors = palette[np.where(labels < 0, len(PALETTE), labels % len(PALETTE))]
+    return W, np.vstack([kept, pieces]), colors
 
 
 def render_png(panels: list, size: tuple[int, int] = (800, 600),
