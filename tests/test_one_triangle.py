@@ -80,10 +80,11 @@ def test_an_unknown_factorization_asked_for_is_one_line_and_invalid_input(tmp_pa
     assert not (tmp_path / "o.obj").exists()
 
 
-def test_a_factorization_that_would_not_fit_is_out_of_memory(monkeypatch):
+def test_a_factorization_that_would_not_fit_is_left_to_superlu(monkeypatch):
+    """SuperLU allocates what it uses and reports a failure; rslab's allocation failures end
+    the process, so a plan beyond the memory there is is not rslab's."""
     monkeypatch.setenv("SRARAP_MEMORY_LIMIT", "1000")
-    with pytest.raises(MemoryError, match="needs"):
-        one_triangle.rslab_factor(_grid(30), single=False)
+    assert one_triangle.rslab_factor(_grid(30), single=False) is None
 
 
 def test_the_factorization_lets_other_python_threads_run():
@@ -118,12 +119,13 @@ def test_a_process_forked_after_rslab_was_used_falls_back_instead_of_hanging():
     assert done.stdout.strip() == "0", done.stderr
 
 
-@pytest.mark.parametrize("room, used", [(60_000_000, "no"), (3_000_000_000, "yes")])
-def test_under_an_address_space_limit_rslab_gets_a_matrix_only_with_room_to_spare(room, used):
+@pytest.mark.parametrize("room, used", [(60_000_000, "no"), (3_000_000_000, "no")])
+def test_under_an_address_space_limit_superlu_takes_every_matrix(room, used):
     """A Rust allocation that fails aborts the process (seen: SIGABRT in the analysis with 60
-    MB to spare), and rslab's threads may not get their stacks (a panic, printing a Rust
-    backtrace): with little room, SuperLU takes the matrix, and solves it or reports a failed
-    allocation as MemoryError (exit 4 in the command)."""
+    MB to spare), rslab's threads may not get their stacks (a panic, printing a Rust
+    backtrace), and its allocator's reservations made fitting not monotonic in the limit
+    (issue 71, MEM-3): under a limit, with little room or much, SuperLU takes the matrix,
+    and solves it or reports a failed allocation as MemoryError (exit 4 in the command)."""
     # OpenBLAS takes its buffer on first use and, under a limit, retries forever: linalg
     # warms it at import when the limit is set before the process starts; here it comes after
     done = _run("import resource\nfrom scipy.linalg import blas\n"

@@ -360,3 +360,36 @@ def test_every_command_that_writes_to_a_full_disk_says_so_in_one_line(command):
     assert done.stderr.splitlines()[-1] == ("srarap: error: <stdout>: cannot write: No space "
                                             "left on device"), done.stderr
     assert "Traceback" not in done.stderr
+
+
+def _limited_by(which, bytes_):
+    return lambda: resource.setrlimit(which, (bytes_, bytes_))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("which, floor", [(resource.RLIMIT_AS, "MIN_START"),
+                                          (resource.RLIMIT_DATA, "MIN_START_DATA")])
+def test_a_small_job_runs_at_every_limit_from_the_floor_up_and_is_refused_below(case, which,
+                                                                                floor):
+    """Issue 71 (MEM-2/4): under ulimit -v 420-540 MB a 16-vertex job was refused ("needs
+    about 6 kB, 0 kB available"), and ulimit -d was not looked at (exit 139, 134, or
+    OpenBLAS retrying for ever). Below the start floor: one line naming the limit and the
+    floor; from it up, every command runs the small job."""
+    from srarap_cli.runtime import limits
+    (case / "jobs.yaml").write_text("jobs: [{mesh: m.obj, handles: h.yaml, output: b.obj}]\n")
+    start = getattr(limits, floor)
+    commands = [["deform", "m.obj", "h.yaml", "-o", "o.obj"],
+                ["info", "m.obj", "h.yaml"], ["render", "m.obj", "-o", "p.png"],
+                ["batch", "jobs.yaml", "-o", "out", "--workers", "2"]]
+    for limit in (start, start + 60_000_000, start + 200_000_000, start + 600_000_000):
+        for command in commands:
+            p = subprocess.run([sys.executable, "-m", "srarap_cli", *command], cwd=case,
+                               timeout=120, capture_output=True, text=True,
+                               preexec_fn=_limited_by(which, limit))
+            assert p.returncode == 0, (limit, command, p.stderr)
+    p = subprocess.run([sys.executable, "-m", "srarap_cli", *commands[0]], cwd=case,
+                       timeout=120, capture_output=True, text=True,
+                       preexec_fn=_limited_by(which, start - 40_000_000))
+    words = "ulimit -v" if which == resource.RLIMIT_AS else "ulimit -d"
+    assert p.returncode == 4 and p.stderr.count("\n") == 1, p.stderr
+    assert f"{words} allows" in p.stderr and f"at least {start // 1_000_000} MB" in p.stderr

@@ -83,6 +83,7 @@ class LazyGroup(click.Group):
             with signals.deferred():
                 defer_unused_numpy_modules()
                 found = getattr(importlib.import_module(f".{module}", __package__), attr)
+            limits.start_libraries()
         except InputError as exc:
             _leave_now(exit_codes.INVALID_INPUT, str(exc))
         except (MemoryError, ImportError, OSError) as exc:

@@ -1,13 +1,17 @@
 """Refuse work that would not fit in memory, early and with an estimate; recognize running out.
 
 What srarap may plan to use is the least of: ``$SRARAP_MEMORY_LIMIT`` (bytes), the memory the
-system has available, the process's address-space limit (``ulimit -v``) and its cgroup's
-memory limit (a container's). Each later allocation that fails anyway (numpy, SuperLU, libigl,
-a worker thread) is reported as "out of memory" with exit code 4.
+system has available, what the process's address-space and data limits (``ulimit -v``,
+``ulimit -d``) leave beyond what is mapped, and its cgroup's memory limit (a container's).
+Each later allocation that fails anyway (numpy, SuperLU, libigl, a worker thread) is reported
+as "out of memory" with exit code 4.
 """
 import math
 import os
 import resource
+import signal
+import threading
+import time
 
 from .errors import InputError
 from .memory import status_bytes
@@ -61,41 +65,131 @@ def _system_available():
         return None
 
 
+#: the address space srarap needs to load its libraries, start BLAS and run a small job:
+#: below about 400 MB (``ulimit -v``) an import failed ("failed to map segment"), ran out of
+#: memory, or spun in OpenBLAS's allocation retries with SIGTERM held back (an import's
+#: signals wait for its end); a 26-vertex job was refused up to 500 MB (its room less
+#: :data:`BLAS_RESERVE`) and ran from 520 MB. Refused below, with this figure in the line, so
+#: that every limit from here up runs a small job (tests/test_signals_and_memory.py sweeps)
+MIN_START = 560_000_000
+#: the same for the data limit (``ulimit -d``: private writable mappings, VmData): at 240-260
+#: MB OpenBLAS gave up ("Memory allocation still failed after 10 retries", exit 1), at
+#: 280-300 MB it retried for ever with SIGTERM held back, the small job was refused up to
+#: 360 MB and ran from 400 MB
+MIN_START_DATA = 440_000_000
+#: seconds a child is given to start BLAS and a thread under a limit (it takes milliseconds)
+PROBE_SECONDS = 10.0
+
+
+class _Limit:
+    def __init__(self, words: str, which: int, field: str, floor: int, base: int):
+        self.words, self.which, self.field, self.floor, self.base = \
+            words, which, field, floor, base
+
+    def soft(self) -> int | None:
+        soft, _ = resource.getrlimit(self.which)
+        return None if soft == resource.RLIM_INFINITY else soft
+
+    def left(self) -> int | None:
+        """What the limit leaves for data: the limit less what is mapped now (the libraries,
+        the data read) and :data:`BLAS_RESERVE`; None without a limit. The reserve stays
+        after BLAS has started: OpenBLAS maps a buffer for each thread that calls it, and one
+        it cannot map ends the process (a 2.9k-vertex solve at 700 MB, its main thread's
+        buffers mapped). (A thread whose stack does not fit is not started: its blocks run
+        on the calling thread.)"""
+        soft = self.soft()
+        if soft is None:
+            return None
+        mapped = status_bytes(self.field)
+        return max(soft - (self.base if mapped is None else mapped) - BLAS_RESERVE, 0)
+
+
+_LIMITS = (_Limit("ulimit -v", resource.RLIMIT_AS, "VmSize", MIN_START, ADDRESS_SPACE_BASE),
+           _Limit("ulimit -d", resource.RLIMIT_DATA, "VmData", MIN_START_DATA,
+                  ADDRESS_SPACE_BASE))
+_started = threading.Event()
+
+
 def _address_space():
-    """What ``ulimit -v`` leaves for data: the limit less what is mapped now (the libraries
-    loaded, the data read) and :data:`BLAS_RESERVE`; None without a limit."""
-    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
-    if soft == resource.RLIM_INFINITY:
-        return None
-    mapped = status_bytes("VmSize")
-    return max(soft - (ADDRESS_SPACE_BASE if mapped is None else mapped) - BLAS_RESERVE, 0)
-
-
-#: the address space srarap needs to load its libraries and start BLAS: below about 400 MB
-#: (``ulimit -v``) an import failed ("failed to map segment"), ran out of memory, or spun in
-#: OpenBLAS's allocation retries with SIGTERM held back (an import's signals wait for its end)
-MIN_START = 420_000_000
+    """The least that ``ulimit -v`` and ``ulimit -d`` leave (see :class:`_Limit`), or None."""
+    known = [left for left in (limit.left() for limit in _LIMITS) if left is not None]
+    return min(known) if known else None
 
 
 def check_start() -> None:
-    """Refuse to load the numeric libraries in an address space too small for them (exit 4,
-    one line), before an import can fail or hang there."""
-    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
-    if soft != resource.RLIM_INFINITY and soft < MIN_START:
-        raise InputError(f"out of memory: ulimit -v allows {_amount(soft)} of address space; "
-                         f"srarap needs at least {_amount(MIN_START)} to load numpy, scipy and "
-                         "libigl (raise ulimit -v)")
+    """Refuse to load the numeric libraries in an address space or data limit too small for
+    them (exit 4, one line), before an import can fail or hang there."""
+    for limit in _LIMITS:
+        soft = limit.soft()
+        if soft is not None and soft < limit.floor:
+            raise InputError(f"out of memory: {limit.words} allows {_amount(soft)}; srarap "
+                             f"needs at least {_amount(limit.floor)} to load numpy, scipy and "
+                             f"libigl (raise {limit.words})")
+
+
+def start_libraries() -> None:
+    """Under a memory limit, start BLAS (its work buffers) and a thread in a child process
+    first, then here. Where they do not fit, OpenBLAS ends the process ("Memory allocation
+    still failed after 10 retries", exit 1) or retries for ever with SIGTERM held back, at
+    limits that are not monotonic in size: a child that fails or takes more than
+    :data:`PROBE_SECONDS` is refused in one line (exit 4) instead. Without a limit, nothing
+    (they start at their first use)."""
+    binding = [limit for limit in _LIMITS if limit.soft() is not None]
+    if not binding or _started.is_set():
+        return
+    if not _starts_in_child():
+        words = " and ".join(f"{limit.words} allows {_amount(limit.soft() or 0)}"
+                             for limit in binding)
+        raise InputError(f"out of memory: {words}; numpy's BLAS could not start in it "
+                         f"(raise {binding[0].words})")
+    _start_here()
+
+
+def _start_here():
+    import numpy as np
+    a = np.ones((64, 64))
+    a @ a  # OpenBLAS maps its buffers at its first product
+    helper = threading.Thread(target=lambda: None)
+    helper.start()
+    helper.join()
+    _started.set()
+
+
+def _starts_in_child() -> bool:
+    pid = os.fork()
+    if pid == 0:  # the child: quiet (OpenBLAS's message is the parent's to put in words)
+        code = 1
+        try:
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, 1)
+            os.dup2(null, 2)
+            _start_here()
+            code = 0
+        finally:
+            os._exit(code)
+    deadline = time.monotonic() + PROBE_SECONDS
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            return os.waitstatus_to_exitcode(status) == 0
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            return False
+        time.sleep(0.005)
 
 
 def address_space_left() -> int | None:
-    """Bytes the address-space limit (``ulimit -v``) leaves beyond what is mapped now; None
-    without a limit. 0 where the mappings cannot be read (not Linux): nothing is known to
-    fit."""
-    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
-    if soft == resource.RLIM_INFINITY:
-        return None
-    mapped = status_bytes("VmSize")
-    return 0 if mapped is None else max(soft - mapped, 0)
+    """Bytes the address-space and data limits (``ulimit -v``, ``ulimit -d``) leave beyond
+    what is mapped now, the lesser; None without a limit. 0 where the mappings cannot be
+    read (not Linux): nothing is known to fit."""
+    left = []
+    for limit in _LIMITS:
+        soft = limit.soft()
+        if soft is not None:
+            mapped = status_bytes(limit.field)
+            left.append(0 if mapped is None else max(soft - mapped, 0))
+    return min(left) if left else None
 
 
 def _cgroup():
@@ -128,8 +222,9 @@ def memory_note() -> str:
     """Where the process's memory bound comes from, for messages."""
     if os.environ.get(ENV, "").strip():
         return f"{ENV}={os.environ[ENV].strip()}"
-    if _address_space() is not None:
-        return "ulimit -v"
+    spaces = [(left, limit.words) for limit in _LIMITS if (left := limit.left()) is not None]
+    if spaces:
+        return min(spaces)[1]
     if _cgroup() is not None:
         return "the container's memory limit"
     return "the memory available"

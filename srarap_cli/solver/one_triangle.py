@@ -14,14 +14,16 @@ half the memory, and orders and factors faster (1.2M-vertex cylinder Laplacian, 
 - rslab refused it or could not start its threads (under ``ulimit -v`` they may not get
   their stacks: it raises a Rust panic, whose text is held back);
 - this process was forked from one that had used rslab: its thread pool does not survive a
-  fork, and a factorization in the child waited forever (seen with one thread too).
+  fork, and a factorization in the child waited forever (seen with one thread too);
+- the process runs under an address-space or data limit (``ulimit -v``, ``ulimit -d``):
+  rslab's allocator (mimalloc) reserves address space in segments it sizes by what it can
+  get, so whether a solve fits was not monotonic in the limit (a 2.9k-vertex solve ran at
+  600 and 750 MB and failed at 700: refused, or OpenBLAS ended the process when no room
+  was left for a thread's buffer). SuperLU allocates what it uses and reports a failure.
 
 Its plan of the memory a factorization needs is checked against what the process may use
-first: a Rust allocation that fails ends the process (SIGABRT), where a refused plan is a
-clean "out of memory" (exit 4). Under an address-space limit (``ulimit -v``) the room left
-is measured (the limit less the mappings already made, 1.2-1.4 GB of them once numpy, scipy
-and OpenBLAS's buffers are in) and rslab gets a matrix only with :data:`SPARE` times its plan
-there: SuperLU, which reports a failed allocation, takes it otherwise.
+first: a Rust allocation that fails ends the process (SIGABRT), where a plan that does not
+fit is SuperLU's, which reports a failed allocation as "out of memory" (exit 4).
 """
 import os
 from typing import Any
@@ -36,10 +38,6 @@ from ..runtime.signals import deferred
 from ..runtime.streams import held_c_stderr
 
 ENV = "SRARAP_FACTOR"
-#: room asked for under an address-space limit, per byte of rslab's plan: its threads' stacks
-#: and allocator arenas are mappings the plan does not count (64 MB a thread for glibc's)
-SPARE = 2
-SPARE_BYTES = 256_000_000
 #: what rslab's analysis takes per stored entry, with a margin (22 measured on a grid)
 ANALYSIS_BYTES_PER_ENTRY = 64
 #: the process that first used rslab (0: none): a child forked from it must not
@@ -69,7 +67,8 @@ def rslab_factor(A: csr_matrix, single: bool) -> Any:
     rslab.Ldlt or None; its ``solve_many(B)`` takes and returns (n, k) float64 arrays
     """
     global _USED_IN
-    if backend() == "superlu" or _USED_IN not in (0, os.getpid()):
+    if backend() == "superlu" or _USED_IN not in (0, os.getpid()) or \
+            address_space_left() is not None:
         return None
     rslab = _module()
     if rslab is None:
@@ -87,8 +86,7 @@ def rslab_factor(A: csr_matrix, single: bool) -> Any:
             plan = rslab.analyze(A, path="ldlt", ordering="amd", threads=threads,
                                  factor_dtype=dtype)
             need = plan.memory_plan(dtype, nrhs=4, threads=threads)["peak_bytes"]
-            _check_memory(need, A.shape[0])
-            if not _room_for(need):
+            if not _room_for(need):  # SuperLU's turn, which says "out of memory" if it must
                 return None
             f = plan.factor(A)
     except MemoryError:
@@ -102,17 +100,12 @@ def rslab_factor(A: csr_matrix, single: bool) -> Any:
     return f if f.inertia == (A.shape[0], 0, 0) else None
 
 
-def _check_memory(need: int, n: int) -> None:
-    have = available_memory()
-    if have is not None and need > have:
-        raise MemoryError(f"factoring a {n}-row matrix needs {need / 1e9:.1f} GB, "
-                          f"{have / 1e9:.1f} GB available")
-
-
 def _room_for(need: int) -> bool:
-    """Whether the address space has room for a plan of ``need`` bytes and its threads."""
-    left = address_space_left()
-    return left is None or left >= SPARE * need + SPARE_BYTES
+    """Whether the memory there is (:func:`available_memory`: the system's, a container's)
+    holds a plan of ``need`` bytes; one that does not is SuperLU's, which says "out of
+    memory" where it must."""
+    have = available_memory()
+    return have is None or need <= have
 
 
 def _module():

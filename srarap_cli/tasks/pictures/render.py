@@ -65,12 +65,13 @@ def draw(ax: Any, V: np.ndarray, F: np.ndarray, colors: np.ndarray, view: str,
     if normals is not None and alpha < 1.0:
         rgb, alpha = alpha * rgb + (1.0 - alpha), 1.0
     rgba = np.column_stack([rgb, np.full(len(F), alpha)])
-    ax.add_artist(_flat_triangles(xy[F[order]], rgba[order]))
+    ax.add_artist(_flat_triangles(ax, xy[F[order]], rgba[order]))
     return xy[:, 0].min(), xy[:, 0].max(), xy[:, 1].min(), xy[:, 1].max()
 
 
-def _flat_triangles(corners: np.ndarray, rgba: np.ndarray) -> Any:
-    """An artist drawing triangles ``corners`` (t, 3, 2), in data coordinates, each in its
+def _flat_triangles(ax: Any, corners: np.ndarray, rgba: np.ndarray) -> Any:
+    """An artist drawing triangles ``corners`` (t, 3, 2), in ``ax``'s data coordinates (as
+    they are when the figure is drawn, after its limits are set), each in its
     colour ``rgba`` (t, 4), in that order, by one call of the renderer's Gouraud triangles
     with the same colour at the three corners: flat triangles without a matplotlib path per
     face (a PolyCollection's were most of an animation sheet's cost: 25 frames of a 12k-face
@@ -82,8 +83,7 @@ def _flat_triangles(corners: np.ndarray, rgba: np.ndarray) -> Any:
     class FlatTriangles(Artist):
         def draw(self, renderer):
             gc = renderer.new_gc()
-            renderer.draw_gouraud_triangles(gc, corners, colors,
-                                            self.axes.transData.frozen())
+            renderer.draw_gouraud_triangles(gc, corners, colors, ax.transData.frozen())
             gc.restore()
 
     return FlatTriangles()
