@@ -233,6 +233,33 @@ def test_a_link_made_while_the_batch_runs_carries_nothing_outside(tmp_path):
     assert not list(elsewhere.iterdir())
 
 
+def test_the_output_folder_swapped_for_a_link_mid_run_carries_nothing_there(tmp_path,
+                                                                            monkeypatch):
+    """Issue 71 (OUTSIDE-3): the batch's -o folder itself replaced by a link while the run
+    went on, every later file landed in the link's target (the check resolved the folder's
+    name again at each write). The folder is held as it was when the run started: later
+    jobs fail without writing, the summary is refused, the link's target stays empty."""
+    from srarap_cli.tasks.batch import run as batch_run
+
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    manifest = _manifest(tmp_path, ["a.obj", "b.obj", "c.obj"])
+    real = batch_run.run_job
+
+    def then_swap(job, *args, **kwargs):
+        row = real(job, *args, **kwargs)
+        if job["name"] == "j0":
+            out.rename(tmp_path / "moved")
+            out.symlink_to(elsewhere)
+        return row
+    monkeypatch.setattr(batch_run, "run_job", then_swap)
+    r = run_cli(["batch", str(manifest), "-o", str(out)])
+    assert r.returncode == 6 and "leads out of the output folder" in r.stderr, r.stderr
+    assert not list(elsewhere.iterdir())
+    assert sorted(p.name for p in (tmp_path / "moved").iterdir() if p.suffix == ".obj") == \
+        ["a.obj"]
+
+
 def test_commit_files_inside_a_folder_refuses_every_way_out(tmp_path):
     from srarap_cli.runtime.commit import commit_files
     from srarap_cli.runtime.errors import OutputError

@@ -7,6 +7,7 @@ import click
 
 from ..runtime import exit_codes
 from ..runtime.errors import OutputError
+from ..runtime.paths import hold
 from ..runtime.signals import Terminated, block
 from ..solver.settings import BY_NAME
 from ..tasks.batch import (
@@ -100,8 +101,9 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
     for name in SUMMARIES:  # before solving, as deform checks its -o
         check_output_path(os.path.join(out, name), None, "summary")
+    held = hold(out)  # every file of the run is written there, whatever -o names later
     try:
-        rows, stopped = run_batch(jobs, out, workers, scheduler, keep_unconverged,
+        rows, stopped = run_batch(jobs, held, workers, scheduler, keep_unconverged,
                                   pictures=report is not None, threads=threads,
                                   heartbeat=None if quiet else job_heartbeat), None
     except BatchInterrupted as exc:  # the workers are stopped: say what finished
@@ -111,7 +113,7 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
         block()
     # the summary first, on its own: a report that cannot be written (a full disk) must not
     # cost the account of the jobs whose outputs are on disk
-    write_summaries(rows, out)
+    write_summaries(rows, held)
     _tell(rows, out, quiet, stopped)
     _tell_goldens(rows, manifest, out, goldens)
     write_reports(rows, manifest, report, junit, markdown, metrics)

@@ -47,6 +47,24 @@ def refuse_overwriting_inputs(outputs: Sequence[str], inputs: Sequence[tuple[str
             raise InputError(f"{out}: is the {what} ({path}); refusing to overwrite an input")
 
 
+class Held(str):
+    """A folder's real path, taken once when a run starts (:func:`hold`). Paths built on it
+    do not pass through the name the user gave, so a link put in that name's place later
+    redirects nothing; and :func:`leads_out` answers for every path in it once it is no
+    longer that real path (the folder, or one above it, swapped for a link mid-run)."""
+
+
+def hold(folder: str) -> Held:
+    """``folder`` held as it is now (see :class:`Held`).
+
+    Examples
+    --------
+    >>> hold("/") == "/" and isinstance(hold("/"), Held)
+    True
+    """
+    return Held(os.path.realpath(folder))
+
+
 def leads_out(path: str, folder: str) -> str | None:
     """Where ``path`` would be written when that is outside ``folder`` (its real path,
     symbolic links followed, in the file's name and in every folder above it); None when it
@@ -60,5 +78,7 @@ def leads_out(path: str, folder: str) -> str | None:
     True
     """
     root = os.path.realpath(folder)
+    if isinstance(folder, Held) and root != folder:
+        return root  # the held folder itself now leads elsewhere
     target = os.path.realpath(path)
     return None if os.path.commonpath([root, target]) == root else target

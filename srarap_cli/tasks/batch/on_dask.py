@@ -7,6 +7,7 @@ from collections.abc import Callable
 
 from ...runtime.environment import environ_changed
 from ...runtime.errors import InputError
+from ...runtime.paths import hold
 from ...runtime.signals import Terminated, block
 from ...runtime.threads import worker_processes
 from ..job_status import JobResult
@@ -53,7 +54,7 @@ def run_on_dask(jobs: list[Job], run: "functools.partial[JobResult]", scheduler:
         from distributed import LocalCluster
     except ImportError:
         raise InputError("--scheduler needs Dask: pip install 'srarap-cli[dask]'") from None
-    run = functools.partial(run, out_dir=os.path.abspath(run.keywords["out_dir"]))
+    run = functools.partial(run, out_dir=hold(run.keywords["out_dir"]))  # absolute, held
     if scheduler != "local":
         return _gather_at(scheduler, jobs, run, scheduler, unfinished)
     # the cluster runs threads from its start: its workers come from a fork server
