@@ -274,3 +274,37 @@ def test_a_selected_corner_of_long_triangles_is_drawn_as_small_as_it_is(tmp_path
     shape = img[..., :3].min(axis=-1) < 0.99
     red, blue = near(img, PALETTE[0], 0.3) & shape, near(img, PALETTE[1], 0.3) & shape
     assert 0.2 < red.sum() / shape.sum() < 0.3 and 0.2 < blue.sum() / shape.sum() < 0.3
+
+
+@pytest.mark.parametrize("corners", ["1e8 1e8 1e8|1e8 1e8 1e8|1e8 1e8 1e8",
+                                     "1e16 0 0|1e16 1e-3 0|1e16 0 1e-3", "5 5 5|5 5 5|5 5 5"])
+def test_a_point_or_a_mesh_flat_in_the_view_far_out_draws_without_a_librarys_words(tmp_path,
+                                                                                     corners):
+    """Issue 71 (MSG-6): the frame's margin vanished beside coordinates of 1e8, and
+    matplotlib's identical-limits warning reached stderr with its source line."""
+    mesh = tmp_path / "m.obj"
+    mesh.write_text("".join(f"v {c}\n" for c in corners.split("|")) + "f 1 2 3\n")
+    for view in ("front", "iso"):
+        r = CliRunner().invoke(main, ["--debug", "render", str(mesh), "-o",
+                                      str(tmp_path / "p.png"), "--up", "z", "--view", view])
+        assert r.exit_code == 0 and r.stderr == "", r.stderr
+
+
+def test_no_librarys_warning_reaches_stderr(tmp_path, monkeypatch):
+    """What matters is said by srarap; a library's warning (its text and its source line)
+    is shown with --debug only."""
+    from srarap_cli.tasks.pictures import render
+
+    real = render.render_png
+
+    def warning(*args, **kwargs):
+        warnings.warn("a library's own words", UserWarning)
+        return real(*args, **kwargs)
+    monkeypatch.setattr(render, "render_png", warning)
+    monkeypatch.setattr("srarap_cli.tasks.pictures.preview.render_png", warning)
+    args = ["render", BAR, "-o", str(tmp_path / "p.png"), "--up", "z"]
+    quiet = CliRunner().invoke(main, args)
+    assert quiet.exit_code == 0 and quiet.stderr == "", quiet.stderr
+    with pytest.warns(UserWarning, match="a library's own words"):  # not swallowed there
+        loud = CliRunner().invoke(main, ["--debug", *args])
+    assert loud.exit_code == 0

@@ -4,6 +4,7 @@ import math
 import os
 import sys
 import traceback
+import warnings
 from collections import Counter
 from collections.abc import Callable, Sequence
 from typing import Any, NoReturn
@@ -85,7 +86,9 @@ def guarded(func: Callable[..., None]) -> Callable[..., None]:
         try:
             # non-finite results are detected and reported as numerical failures; numpy's own
             # floating-point warnings would only add multi-line noise to stderr
-            with signals.routed(), np.errstate(all="ignore"):
+            with signals.routed(), np.errstate(all="ignore"), warnings.catch_warnings():
+                if not debug:  # a library's warning is its text and its source line on
+                    warnings.simplefilter("ignore")  # stderr: what matters is said by srarap
                 default_threads()  # a bad $SRARAP_THREADS: the same line in every command
                 return func(*args, **kwargs)
         except (click.exceptions.Exit, click.ClickException, SystemExit):

@@ -177,7 +177,10 @@ def _frame(axes, boxes):
     """The same limits on every axes of a view, around all its meshes, with a margin."""
     x0, x1 = min(b[0] for b in boxes), max(b[1] for b in boxes)
     y0, y1 = min(b[2] for b in boxes), max(b[3] for b in boxes)
-    pad = 0.05 * max(x1 - x0, y1 - y0, 1e-12)
+    # a mesh flat in the view, or one point, far from the origin: a margin that still
+    # separates the limits in floating point (1e-12 beside 1e8 vanished)
+    pad = max(0.05 * max(x1 - x0, y1 - y0), 1e-9 * max(abs(x0), abs(x1), abs(y0), abs(y1)),
+              1e-12)
     for ax in axes:
         ax.set_xlim(x0 - pad, x1 + pad)
         ax.set_ylim(y0 - pad, y1 + pad)
