@@ -298,7 +298,7 @@ def test_no_librarys_warning_reaches_stderr(tmp_path, monkeypatch):
     real = render.render_png
 
     def warning(*args, **kwargs):
-        warnings.warn("a library's own words", UserWarning)
+        warnings.warn("a library's own words", UserWarning, stacklevel=2)
         return real(*args, **kwargs)
     monkeypatch.setattr(render, "render_png", warning)
     monkeypatch.setattr("srarap_cli.tasks.pictures.preview.render_png", warning)
