@@ -308,3 +308,22 @@ def test_no_librarys_warning_reaches_stderr(tmp_path, monkeypatch):
     with pytest.warns(UserWarning, match="a library's own words"):  # not swallowed there
         loud = CliRunner().invoke(main, ["--debug", *args])
     assert loud.exit_code == 0
+
+
+def test_the_rest_shape_may_come_from_standard_input(tmp_path):
+    """Issue 71 (MSG-5): ``--rest -`` said "No such file or directory"."""
+    shown = tmp_path / "bent.obj"
+    write_mesh(str(shown), tube_mesh())
+    rest = tube_mesh()
+    rest_file = tmp_path / "rest.obj"
+    write_mesh(str(rest_file), rest.with_vertices(rest.vertices * [1, 1, 1.1]))
+    by_file, by_stdin = tmp_path / "a.png", tmp_path / "b.png"
+    assert invoke("render", shown, "--rest", rest_file, "-o", by_file, "--up", "z"
+                  ).exit_code == 0
+    r = CliRunner().invoke(main, ["render", str(shown), "--rest", "-", "-o", str(by_stdin),
+                                  "--up", "z"], input=rest_file.read_bytes())
+    assert r.exit_code == 0, r.stderr
+    assert by_stdin.read_bytes() == by_file.read_bytes()
+    both = CliRunner().invoke(main, ["render", "-", "--rest", "-", "-o", str(by_stdin)],
+                              input=rest_file.read_bytes())
+    assert both.exit_code == 2 and "both be standard input" in both.stderr

@@ -102,9 +102,14 @@ def run_render(job: RenderJob, on_note: Callable[[str], None] | None = None) -> 
         check_view(view)
     refuse_overwrite([job.out], mesh=job.mesh, handles=job.handles,
                      others=[("rest mesh", job.rest)] if job.rest else [])
-    with reading_beside(job.rest) as rest:  # the rest shape read beside the shown one
-        shown = read_any_mesh(job.mesh, job.input_format)[0]
-        base = rest()
+    if job.rest == "-" and job.mesh == "-":
+        raise UsageProblem("MESH and --rest cannot both be standard input (-)")
+    if job.rest == "-":  # the rest shape from standard input, the shown mesh from its file
+        base, shown = read_any_mesh("-")[0], read_any_mesh(job.mesh, job.input_format)[0]
+    else:
+        with reading_beside(job.rest) as rest:  # the rest shape read beside the shown one
+            shown = read_any_mesh(job.mesh, job.input_format)[0]
+            base = rest()
     if base is not None and len(base.vertices) != len(shown.vertices):
         raise UsageProblem("--rest: the rest mesh must have the same vertices")
     if job.color == "distortion" and base is None:
