@@ -355,3 +355,17 @@ def test_one_reading_of_a_thread_count_for_the_option_the_variable_and_the_key(t
     assert r.returncode == 2 and "positive whole number" in r.stderr
     with pytest.raises(ValueError, match="positive whole number"):
         resolve({"threads": value})
+
+
+def test_a_capped_thread_count_is_said_once_with_v(tmp_path):
+    """Issue 71: a count past the CPUs is a documented cap, said once with -v."""
+    args = ["deform", os.path.join(ROOT, "sample_meshes", "bar.obj"),
+            os.path.join(ROOT, "configs", "bar-twist.yaml"), "-o", "o.obj", "-v"]
+    capped = run_cli([*args, "--threads", "1000000"], cwd=tmp_path)
+    assert capped.returncode == 0, capped.stderr
+    said = [line for line in capped.stderr.splitlines() if line.startswith("srarap: threads:")]
+    assert said == [f"srarap: threads: 1000000 asked, {parallel.available_cpus()} used (the "
+                    "CPUs this process may use: a count is capped there, and the results do "
+                    "not depend on it)"]
+    plain = run_cli([*args, "--threads", "1"], cwd=tmp_path)
+    assert "srarap: threads:" not in plain.stderr

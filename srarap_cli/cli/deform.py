@@ -5,6 +5,7 @@ import click
 
 from ..io.mesh.formats import MeshFormat
 from ..runtime import exit_codes, memory
+from ..runtime.parallel import cap_note
 from ..runtime.stages import heard_by
 from ..tasks.deform import DeformJob, JobStatus, cache_hint, run_job, summary_line
 from .common import (
@@ -76,6 +77,7 @@ def deform(mesh: str, handles: str, out: str, input_format: MeshFormat | None,
     measured = memory.gigabytes(done.peaks)
     report(verbosity, warnings=early.rest(done.warnings),
            details=done.solve.report_lines() + cache_hint(done.solve, cache)
+           + cap_note(done.settings.threads)
            + ([f"srarap: peak memory: {measured}"] if measured else []),
            summary=summary_line(done.solve, done.settings,
                             done.written and ("<stdout>" if out == "-" else out)))

@@ -177,6 +177,24 @@ def thread_count(value: object) -> int | None:
     return value
 
 
+def cap_note(asked: int | None) -> list[str]:
+    """The ``-v`` line that says a thread count (``asked``: ``--threads`` or the setting;
+    None: ``$SRARAP_THREADS`` or the CPUs) was capped at the CPUs this process may use, or
+    nothing where it was not.
+
+    Examples
+    --------
+    >>> cap_note(1)
+    []
+    """
+    count = default_threads() if asked is None else asked
+    cpus = available_cpus()
+    if count <= cpus:
+        return []
+    return [f"srarap: threads: {count} asked, {cpus} used (the CPUs this process may use: "
+            "a count is capped there, and the results do not depend on it)"]
+
+
 def current_threads() -> int:
     """The thread count of the code running now (see the module's docstring), within any
     :func:`at_most` around it, and never more than the CPUs this process may use
