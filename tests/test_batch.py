@@ -162,3 +162,20 @@ def test_changing_only_the_strictness_judges_the_record_again_without_solving(tm
                                 "output": "slip.obj"}])
     r, rows = run(path, out)  # another handle file: solved, and failed by its own strict
     assert r.exit_code == 8 and rows["slip"]["status"] == "failed"
+
+
+def test_the_codes_allow_accepts_add_up_over_defaults_job_and_command_line(tmp_path):
+    """Issue 72: a job's own ``allow`` replaced the defaults' (``{**defaults, **job}``),
+    while the docs and ``resolve`` add them up. Here only the defaults' code accepts the
+    job's warning; the job's and the command line's codes are others."""
+    h = tmp_path / "slip.yaml"  # a forgotten fixed group: a [rigid-part] warning
+    h.write_text(yaml.safe_dump({"groups": {"top": {
+        "box": {"min": [-2, -2, 9.99], "max": [2, 2, 10.01]}, "translate": [1, 0, 0]}}}))
+    job = {"name": "slip", "mesh": BAR, "handles": str(h), "output": "slip.obj",
+           "settings": {"allow": ["needles"]}}
+    path = manifest(tmp_path, [job], {"strict": True, "allow": ["rigid-part"]})
+    r, rows = run(path, tmp_path / "out", "--allow", "units")
+    assert r.exit_code == 0 and rows["slip"]["status"] == "ok", rows["slip"]["message"]
+    path = manifest(tmp_path, [job], {"strict": True})  # without it: failed by strict
+    r, rows = run(path, tmp_path / "out2", "--allow", "units")
+    assert rows["slip"]["status"] == "failed" and "[rigid-part]" in rows["slip"]["message"]

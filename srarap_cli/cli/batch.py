@@ -9,7 +9,7 @@ from ..runtime import exit_codes
 from ..runtime.errors import OutputError
 from ..runtime.paths import hold
 from ..runtime.signals import Terminated, block
-from ..solver.settings import BY_NAME
+from ..solver.settings import BY_NAME, overlay
 from ..tasks.batch import (
     SUMMARIES,
     BatchInterrupted,
@@ -88,9 +88,8 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     goldens = "accept" if accept_goldens else "update" if update_goldens else "check"
     jobs = load_manifest(manifest)
     for job in jobs:  # over the manifest's defaults and each job's settings, as in deform
-        mine = job["settings"]
-        job["settings"] = {**mine, **({"strict": strict} if strict else {}),
-                           **({"allow": [*mine.get("allow", ()), *allow]} if allow else {})}
+        job["settings"] = overlay(job["settings"], {"strict": strict or None,
+                                                    "allow": allow or None})
         job["goldens"] = goldens
     if goldens != "check":
         check_goldens(jobs, manifest)

@@ -261,17 +261,33 @@ def resolve(*layers: "Mapping[str, Any] | Settings") -> Settings:
 
     Raises ValueError naming the setting for a bad value, KeyError for an unknown name.
     """
-    merged = dict(DEFAULTS)
+    layered = overlay(DEFAULTS, *(layer.as_dict() if isinstance(layer, Settings) else layer
+                                  for layer in layers))
+    return Settings(**{**DEFAULTS, **layered})  # the defaults that are None stay so
+
+
+def overlay(*layers: Mapping[str, Any]) -> dict[str, Any]:
+    """Setting mappings laid one over the other as :func:`resolve` lays them (later layers
+    win, None is "not given", ``allow``'s codes add up), without the defaults: a manifest's
+    ``defaults`` under a job's ``settings`` under the command line's options.
+
+    Raises KeyError for an unknown name.
+
+    Examples
+    --------
+    >>> overlay({"tol": 1e-6, "allow": ["needles"]}, {"tol": 1e-8, "allow": "units"})
+    {'tol': 1e-08, 'allow': ('needles', 'units')}
+    """
+    merged: dict[str, Any] = {}
     for layer in layers:
-        items = layer.as_dict() if isinstance(layer, Settings) else layer
-        for name, value in items.items():
+        for name, value in layer.items():
             if name not in BY_NAME:
                 raise KeyError(f"unknown setting {name!r}")
             if value is not None and BY_NAME[name].kind == "codes":  # accepted by any layer
-                merged[name] = (*parse_codes(merged[name]), *parse_codes(value))
+                merged[name] = (*parse_codes(merged.get(name, ())), *parse_codes(value))
             elif value is not None:
                 merged[name] = value
-    return Settings(**merged)
+    return merged
 
 
 def keywords(options: Mapping[str, Any], stages: tuple[str, ...],

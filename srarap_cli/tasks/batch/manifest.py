@@ -7,7 +7,7 @@ from ...io.handles import referenced_files
 from ...io.mesh.formats import extensions, suffix_of
 from ...runtime.errors import InputError, excerpt, unknown_key
 from ...runtime.paths import leads_out, refuse_overwriting_inputs
-from ...solver.settings import parse_mapping
+from ...solver.settings import overlay, parse_mapping
 from ..comparison import parse_expect, record_path, refuse_leading_out
 from .rows import Job
 
@@ -51,8 +51,8 @@ def load_manifest(path: str) -> list[Job]:
         jobs.append({"name": name, "mesh": os.path.join(base, str(job["mesh"])),
                      "handles": os.path.join(base, str(job["handles"])),
                      "output": output, "expect": expect, "golden_root": base,
-                     "settings": {**defaults, **_settings(where, "settings",
-                                                          job.get("settings", {}))}})
+                     "settings": overlay(defaults, _settings(where, "settings",
+                                                             job.get("settings", {})))})
     return jobs
 
 
