@@ -86,3 +86,31 @@ def test_render_takes_every_frame_animate_may_write(tmp_path):
     assert r.exit_code == 0, r.output
     r = CliRunner().invoke(main, ["render", pattern, "-o", str(tmp_path / "a.gif")])
     assert r.exit_code == 4 and "10001 frames, more than a GIF takes (10000)" in r.output
+
+
+def test_a_sheet_drawn_by_several_processes_is_the_one_drawn_by_one(frames, tmp_path,
+                                                                     monkeypatch):
+    """The frames are read and drawn in as many processes as there are CPUs (a parse and a
+    figure hold the GIL): the same bytes with one process or three."""
+    from srarap_cli.tasks.pictures import jobs
+    sheets = []
+    for cpus in (1, 3):
+        monkeypatch.setattr(jobs, "available_cpus", lambda cpus=cpus: cpus)
+        out = tmp_path / f"s{cpus}.png"
+        r = render(frames, "--handles", TWIST, "-o", out, "--size", "100x120")
+        assert r.exit_code == 0, r.stderr
+        sheets.append(out.read_bytes())
+    assert sheets[0] == sheets[1]
+
+
+def test_a_frame_that_cannot_be_read_in_a_drawing_process_is_one_line(frames, tmp_path,
+                                                                       monkeypatch):
+    from srarap_cli.tasks.pictures import jobs
+    monkeypatch.setattr(jobs, "available_cpus", lambda: 3)
+    broken = tmp_path / "f_{:02d}.obj"
+    for k in range(5):
+        text = open(frames.format(k)).read()
+        (tmp_path / f"f_{k:02d}.obj").write_text("v 1 2\n" if k == 1 else text)
+    r = render(broken, "-o", tmp_path / "s.png")
+    assert r.exit_code == 4 and len(r.stderr.splitlines()) == 1, r.stderr
+    assert "f_01.obj" in r.stderr and not (tmp_path / "s.png").exists()

@@ -74,6 +74,37 @@ def start_bounded(func: Callable[..., Any], *args: Any, seconds: float,
     return Pending(None, (pid, read, time.monotonic() + seconds, seconds))
 
 
+def map_forked(func: Callable[[Any], Any], items: list, parts: int,
+               seconds: float) -> list:
+    """``[func(x) for x in items]`` in ``parts`` contiguous runs, each but the last in a
+    child process (forked: what this process holds, the children have), the last here; the
+    results in order, pickled back. For independent CPU-bound work that holds the GIL (a
+    file's parse, a matplotlib figure), where threads would take turns. One part, or a
+    process with other threads (a fork copies only the thread that makes it), runs here.
+
+    Examples
+    --------
+    >>> map_forked(lambda x: x * x, [1, 2, 3, 4, 5], parts=2, seconds=60)
+    [1, 4, 9, 16, 25]
+    """
+    import threading
+    parts = max(1, min(parts, len(items)))
+    cut = [len(items) * k // parts for k in range(parts + 1)]
+    runs = [items[cut[k]:cut[k + 1]] for k in range(parts)]
+    here = parts == 1 or threading.active_count() > 1
+
+    def run(part):
+        return [func(x) for x in part]
+    calls = [start_bounded(run, part, seconds=seconds, memory=None, here=here)
+             for part in runs[:-1]]
+    try:
+        last = run(runs[-1])
+        return [x for call in calls for x in call.result()] + last
+    finally:
+        for call in calls:
+            call.__exit__()
+
+
 class Pending:
     """A call of :func:`start_bounded`: in a child process, or to run here."""
 

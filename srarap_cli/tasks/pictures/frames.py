@@ -7,15 +7,19 @@ import numpy as np
 
 from ...io.handles import Constraints
 from ...io.mesh.mesh import Mesh
+from ...runtime.bounded import map_forked
 from .preview import preview_png
 
 #: a contact sheet shows at most this many frames (evenly spread, first and last included)
 SHEET_FRAMES = 24
+#: seconds a frame's picture may take in a drawing process (about 0.15 s for 12k faces)
+DRAW_SECONDS = 60.0
 
 
 def frame_pictures(meshes: Sequence[Mesh], numbers: Sequence[int],
                    constraints: Constraints | None = None, view: str = "iso",
-                   size: tuple[int, int] = (480, 360), up: str = "y") -> list[bytes]:
+                   size: tuple[int, int] = (480, 360), up: str = "y",
+                   parts: int = 1) -> list[bytes]:
     """One PNG per mesh of an animation, all framed alike (around every frame's extent) so
     the mesh moves and the camera does not; each captioned with its frame number.
 
@@ -24,13 +28,17 @@ def frame_pictures(meshes: Sequence[Mesh], numbers: Sequence[int],
     meshes : list of Mesh, the frames (same vertices and faces)
     numbers : list of int, their frame numbers
     constraints : Constraints, optional, handle groups to colour (selected on frame 0)
+    parts : int, processes drawing them side by side (:func:`~srarap_cli.runtime.bounded.
+        map_forked`: a figure holds the GIL), the same pictures at any count
     """
     corners = np.array([[m.vertices.min(axis=0), m.vertices.max(axis=0)] for m in meshes])
     lo, hi = corners[:, 0].min(axis=0), corners[:, 1].max(axis=0)
     box = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
                     for z in (lo[2], hi[2])])
-    return [preview_png(m, None, constraints, view=view, size=size, up=up, framed=box,
-                        caption=f"frame {k}") for m, k in zip(meshes, numbers)]
+    return map_forked(lambda k: preview_png(meshes[k], None, constraints, view=view,
+                                            size=size, up=up, framed=box,
+                                            caption=f"frame {numbers[k]}"),
+                      list(range(len(meshes))), parts, DRAW_SECONDS * len(meshes))
 
 
 def animated_gif(pictures: Sequence[bytes], fps: float = 12.0) -> bytes:

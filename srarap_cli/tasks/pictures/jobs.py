@@ -12,8 +12,10 @@ from ...io.handles import load_handles
 from ...io.mesh import read_mesh, reading_beside
 from ...io.mesh.formats import MeshFormat
 from ...io.solve_log import read_log
+from ...runtime.bounded import map_forked, time_bound
 from ...runtime.commit import commit_files
 from ...runtime.errors import InputError, UsageProblem
+from ...runtime.parallel import available_cpus
 from .. import job_fields as fields
 from ..animate import frame_paths
 from ..info import up_axis, up_decided
@@ -137,13 +139,16 @@ def _frames(job, on_note):
                          f"({MAX_GIF_FRAMES}); -o sheet.png draws 24 of them")
     refuse_overwrite([job.out], handles=job.handles, others=[("frame", p) for p in paths])
     numbers = list(range(len(paths))) if gif else sheet_choice(len(paths))
-    meshes = [read_mesh(paths[k]) for k in numbers]  # a sheet reads only the frames it draws
+    # a sheet reads only the frames it draws; parsing and drawing hold the GIL: processes
+    parts = available_cpus()
+    meshes = map_forked(read_mesh, [paths[k] for k in numbers], parts,
+                        time_bound(sum(os.path.getsize(paths[k]) for k in numbers)))
     if any(len(m.vertices) != len(meshes[0].vertices) for m in meshes):
         raise InputError(f"{job.mesh}: the frames do not all have the same vertices")
     constraints = (load_handles(job.handles, meshes[0].vertices, any_rate=True)
                    if job.handles else None)
     up = _auto_up(meshes[0], on_note) if job.up == "auto" else job.up
-    pictures = frame_pictures(meshes, numbers, constraints, job.views[0], size, up)
+    pictures = frame_pictures(meshes, numbers, constraints, job.views[0], size, up, parts)
     data = animated_gif(pictures, job.fps) if gif else contact_sheet(pictures)
     commit_files([(job.out, data)])
 
