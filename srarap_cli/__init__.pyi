@@ -1,14 +1,13 @@
-# The public names' types for editors and type checkers: the package loads them lazily
-# (__init__.py's __getattr__), which a checker cannot follow. Keep in step with _WHERE there
-# (tests/test_api_types.py checks both name the same objects).
-from .io.handles import Constraints as Constraints
-from .io.handles import as_constraints as as_constraints
-from .io.handles import load_handles as load_handles
-from .io.mesh import Mesh as Mesh
-from .io.mesh import read_mesh as read_mesh
-from .io.mesh import write_mesh as write_mesh
+# The public names, the only list of them: type checkers read it, and __init__.py loads
+# each name from the module named here on first use (attach_stub).
+from .io.handles.parse import Constraints as Constraints
+from .io.handles.parse import as_constraints as as_constraints
+from .io.handles.parse import load_handles as load_handles
+from .io.mesh.files import read_mesh as read_mesh
+from .io.mesh.files import write_mesh as write_mesh
 from .io.mesh.formats import MeshFormat as MeshFormat
 from .io.mesh.formats import register_format as register_format
+from .io.mesh.mesh import Mesh as Mesh
 from .solver.deformer import Deformer as Deformer
 from .solver.interface import Solver as Solver
 from .solver.oneshot import make_deformer as make_deformer

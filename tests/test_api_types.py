@@ -149,7 +149,7 @@ def test_the_public_names_type_check_for_a_user(tmp_path):
     import srarap_cli
 
     stub = open(f"{ROOT}/srarap_cli/__init__.pyi").read()
-    assert all(f"import {name} as {name}" in stub for name in srarap_cli._WHERE)
+    assert all(f"import {name} as {name}" in stub for name in srarap_cli.__all__)
     (tmp_path / "user.py").write_text(
         "import srarap_cli\n"
         "reveal_type(srarap_cli.Deformer)\n"

@@ -35,9 +35,38 @@ def _layer(module):
     return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else len(LAYERS)
 
 
-def _imports(module, path):
+def _lazy(package):
+    """``{name: module}`` of a package that loads its names from its stub on first use
+    (``runtime/lazy_names.py``), each name's module absolute; {} for another package."""
+    from srarap_cli.runtime.lazy_names import stub_names
+    path = MODULES.get(package, "")
+    if not path.endswith("__init__.py") or not os.path.exists(path[:-3] + ".pyi"):
+        return {}
+    out = {}
+    for name, (relative, _) in stub_names(path).items():
+        level = len(relative) - len(relative.lstrip("."))
+        base = package.split(".")[:len(package.split(".")) - level + 1]
+        out[name] = ".".join(base + ([relative.lstrip(".")] if relative.lstrip(".") else []))
+    return out
+
+
+def _defining(target, name):
+    """The module that defines ``name`` taken from ``target``: through a lazy package's stub
+    (and a stub that names another lazy package, through its stub in turn), else
+    ``target``."""
+    seen = set()
+    while target not in seen and name in _lazy(target):
+        seen.add(target)
+        target = _lazy(target)[name]
+    return target
+
+
+def _imports(module, path, through_stubs=True):
     """The package's modules ``module`` imports at run time (anywhere in it, functions too;
-    not what an ``if TYPE_CHECKING:`` block imports for annotations only)."""
+    not what an ``if TYPE_CHECKING:`` block imports for annotations only). A name taken from
+    a lazy package counts as an import of the module that defines it (``through_stubs``):
+    the package's ``__init__`` imports nothing, and an edge that stopped there would hide a
+    cycle through it; without, the package as written."""
     tree = ast.parse(open(path, encoding="utf-8").read())
     hidden = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If)
               and getattr(node.test, "id", "") == "TYPE_CHECKING" for n in ast.walk(node)}
@@ -54,7 +83,8 @@ def _imports(module, path):
                 target = node.module or ""
             for alias in node.names:
                 sub = f"{target}.{alias.name}"
-                found.add(sub if sub in MODULES else target)
+                found.add(sub if sub in MODULES else _defining(target, alias.name)
+                          if through_stubs else target)
         elif isinstance(node, ast.Import):
             found.update(alias.name for alias in node.names)
     return {m for m in found if m in MODULES and m != module}
@@ -75,22 +105,38 @@ def test_no_layer_imports_a_layer_above_it():
 
 
 def test_the_import_graph_has_no_cycle():
+    assert _cycles(GRAPH) == []
+
+
+def test_a_cycle_through_lazy_wings_is_seen():
+    """Issue 72: an edge to a lazy package was a dead end (its ``__init__`` imports
+    nothing), so a cycle through two wings passed. Planted: ``pictures/preview.py`` takes
+    ``run_job`` from the deform wing, whose job module reaches the pictures wing."""
+    assert _defining("srarap_cli.tasks.deform", "run_job") == "srarap_cli.tasks.deform.job"
+    assert _defining("srarap_cli", "RenderJob") == "srarap_cli.tasks.pictures.jobs"
+    planted = {m: set(t) for m, t in GRAPH.items()}
+    planted["srarap_cli.tasks.pictures.preview"].add(_defining("srarap_cli.tasks.deform",
+                                                               "run_job"))
+    assert any("srarap_cli.tasks.pictures.preview" in cycle for cycle in _cycles(planted))
+
+
+def _cycles(graph):
     """Depth-first search; a module met again on the current path closes a cycle."""
     state, cycles = {}, []
 
     def visit(m, path):
         state[m] = "open"
-        for t in sorted(GRAPH[m]):
+        for t in sorted(graph[m]):
             if state.get(t) == "open":
                 cycles.append(path[path.index(t):] + [t])
             elif t not in state:
                 visit(t, path + [t])
         state[m] = "done"
 
-    for m in sorted(GRAPH):
+    for m in sorted(graph):
         if m not in state:
             visit(m, [m])
-    assert cycles == []
+    return cycles
 
 
 @pytest.mark.parametrize("layer", LAYERS)
@@ -147,7 +193,7 @@ def test_package_files_only_re_export():
     """A package's ``__init__`` holds its docstring and re-exports (imports, ``__all__``; a
     lazy package its table of names and module ``__getattr__`` / ``__dir__``): the code lives
     in modules named for what they do."""
-    allowed_names = {"__all__", "_WHERE", "__getattr__"}
+    allowed_names = {"__all__", "__getattr__", "__dir__", "_getattr", "_dir"}
     for module, path in MODULES.items():
         if not path.endswith("__init__.py"):
             continue
@@ -157,7 +203,9 @@ def test_package_files_only_re_export():
                   or (isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant))
                   or (isinstance(node, (ast.Assign, ast.AnnAssign)) and all(
                       isinstance(t, ast.Name) and t.id in allowed_names
-                      for t in (node.targets if isinstance(node, ast.Assign) else [node.target])))
+                      for target in (node.targets if isinstance(node, ast.Assign)
+                                     else [node.target])
+                      for t in (target.elts if isinstance(target, ast.Tuple) else [target])))
                   or (isinstance(node, ast.FunctionDef) and node.name in ("__getattr__",
                                                                           "__dir__")))
             assert ok, f"{module}: line {node.lineno} is not a re-export"
@@ -198,22 +246,54 @@ def test_a_wing_reaches_another_only_through_its_package():
     modules) takes a wing's names from its package, never from a module inside it."""
     found = []
     for module, path in MODULES.items():
-        for target in _imports(module, path):
+        for target in _imports(module, path, through_stubs=False):
             wing = _wing(target)
             if wing and _wing(module) != wing and target != f"srarap_cli.tasks.{wing}":
                 found.append(f"{module} -> {target}")
     assert not found, found
 
 
-@pytest.mark.parametrize("wing", WINGS)
-def test_each_wing_types_what_it_exports(wing):
-    """A wing's package loads its names lazily (no import cycle between wings, and no cost
-    for a command that does not use them); its ``__init__.pyi`` gives a checker every one."""
-    import importlib
+LAZY = sorted(m for m in MODULES if _lazy(m))
 
-    package = importlib.import_module(f"srarap_cli.tasks.{wing}")
-    stub = open(os.path.join(PACKAGE, "tasks", wing, "__init__.pyi"), encoding="utf-8").read()
-    for name, where in package._WHERE.items():
-        assert f"from .{where} import {name} as {name}" in stub, name
-        assert getattr(package, name) is getattr(
-            importlib.import_module(f"srarap_cli.tasks.{wing}.{where}"), name)
+
+def test_the_lazy_packages_are_the_wings_the_solvers_multires_and_the_top():
+    assert LAZY == sorted(["srarap_cli", "srarap_cli.solver.multires",
+                           *(f"srarap_cli.tasks.{w}" for w in WINGS)])
+
+
+@pytest.mark.parametrize("package", LAZY)
+def test_a_lazy_packages_stub_is_its_one_list_and_names_where_each_name_is_made(package):
+    """Issue 72: the names were kept twice (a table and the stub), and a stub could take a
+    name from a module that only re-imports it. The stub is the only list; each name is
+    defined (def, class, assignment) in the module it names, or taken from another lazy
+    package's list; ``dir()``, ``__all__`` and attribute access follow the stub."""
+    import importlib
+    loaded = importlib.import_module(package)
+    names = _lazy(package)
+    assert loaded.__all__ == sorted(names) and set(names) <= set(dir(loaded))
+    for name, module in names.items():
+        if _lazy(module):
+            assert name in _lazy(module), (name, module)
+            continue
+        tree = ast.parse(open(MODULES[module], encoding="utf-8").read())
+        made = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+        made |= {t.id for n in tree.body if isinstance(n, (ast.Assign, ast.AnnAssign))
+                 for t in (n.targets if isinstance(n, ast.Assign) else [n.target])
+                 if isinstance(t, ast.Name)}
+        assert name in made, f"{package}.{name}: not made in {module}"
+        assert getattr(loaded, name) is getattr(importlib.import_module(module), name)
+
+
+def test_every_lazy_name_imports_eagerly_in_a_fresh_process():
+    """The CI leg's check, here too: with SRARAP_EAGER_IMPORTS=1 importing the package
+    imports every name of every lazy package, so a name a stub lists but its module lacks
+    fails at once."""
+    import subprocess
+    import sys
+    code = ("import sys, srarap_cli; loaded = sorted(m for m in sys.modules if "
+            f"m.startswith('srarap_cli.')); missing = [m for m in {LAZY!r} if m not in "
+            "sys.modules and m != 'srarap_cli']; assert not missing, missing; "
+            "assert 'srarap_cli.tasks.deform.job' in loaded")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env={**os.environ, "SRARAP_EAGER_IMPORTS": "1"}, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]

@@ -6,12 +6,6 @@ The entry: a frozen :class:`~.job.AnimateJob`, :func:`~.job.run_animation` and i
 :class:`~.job.AnimationOutcome` (``exit_code``, ``warnings``, ``summary()``). Names are imported
 on first use.
 """
-from ...runtime.lazy_names import lazy_getattr
+from ...runtime.lazy_names import attach_stub
 
-_WHERE = {"AnimateJob": "job", "run_animation": "job", "AnimationOutcome": "job",
-          "Animator": "sequence", "MAX_FRAMES": "frame_files", "frame_paths": "frame_files"}
-
-__all__ = sorted(_WHERE)
-
-
-__getattr__ = lazy_getattr(__name__, _WHERE)
+__getattr__, __dir__, __all__ = attach_stub(__name__, __file__)

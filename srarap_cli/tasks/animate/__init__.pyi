@@ -1,5 +1,5 @@
-# The wing's names for type checkers: the package loads them lazily (__init__.py's
-# __getattr__). Keep in step with _WHERE there (tests/test_layers.py checks it).
+# The wing's names, the only list of them: type checkers read it, and the package's
+# __init__.py loads each name from the module named here on first use (attach_stub).
 from .frame_files import MAX_FRAMES as MAX_FRAMES
 from .frame_files import frame_paths as frame_paths
 from .job import AnimateJob as AnimateJob

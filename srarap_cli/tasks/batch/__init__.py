@@ -7,14 +7,6 @@ jobs that did not finish (``rows``), and the summary files, report and JUnit it 
 Names are imported on first use, and nothing here imports ``worker_start``, which changes the
 signals of the process that imports it.
 """
-from ...runtime.lazy_names import lazy_getattr
+from ...runtime.lazy_names import attach_stub
 
-_WHERE = {"run_batch": "run", "BatchInterrupted": "rows", "load_manifest": "manifest",
-          "check_outputs": "manifest", "check_goldens": "manifest",
-          "write_summaries": "summary", "write_reports": "summary",
-          "run_on_dask": "on_dask", "run_in_processes": "worker_pool", "SUMMARIES": "summary"}
-
-__all__ = sorted(_WHERE)
-
-
-__getattr__ = lazy_getattr(__name__, _WHERE)
+__getattr__, __dir__, __all__ = attach_stub(__name__, __file__)

@@ -7,16 +7,6 @@ between corresponding meshes (``align``); the gates of a golden, quantity by qua
 :class:`~.job.CompareJob`, :func:`~.job.run_compare`, :class:`~.job.CompareOutcome`). Names are
 imported on first use.
 """
-from ...runtime.lazy_names import lazy_getattr
+from ...runtime.lazy_names import attach_stub
 
-_WHERE = {"Comparison": "compare", "Verdict": "compare", "compare_meshes": "compare",
-          "CompareJob": "job", "CompareOutcome": "job", "run_compare": "job",
-          "Expect": "gates", "Observed": "gates", "judge": "gates", "parse_expect": "gates",
-          "verdict_line": "gates",
-          "EXPECT_KEYS": "gates", "GATE_KEYS": "gates", "read_golden_record": "goldens",
-          "write_golden": "goldens", "refuse_leading_out": "goldens", "record_path": "goldens"}
-
-__all__ = sorted(_WHERE)
-
-
-__getattr__ = lazy_getattr(__name__, _WHERE)
+__getattr__, __dir__, __all__ = attach_stub(__name__, __file__)

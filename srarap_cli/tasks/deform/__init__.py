@@ -6,14 +6,6 @@ The entry: a frozen :class:`~.job.DeformJob`, :func:`~.job.run_job`, and its out
 :class:`~srarap_cli.tasks.job_status.JobResult` (exit code, warnings). Other wings reach it
 through this package; names are imported on first use.
 """
-from ...runtime.lazy_names import lazy_getattr
+from ...runtime.lazy_names import attach_stub
 
-_WHERE = {"DeformJob": "job", "run_job": "job", "run_job_safely": "job", "recorded_result": "job",
-          "check_golden": "golden", "summary_line": "advice", "cache_hint": "advice",
-          "fingerprint": "record", "sidecar_path": "record", "JobStatus": "job",
-          "JobResult": "job"}
-
-__all__ = sorted(_WHERE)
-
-
-__getattr__ = lazy_getattr(__name__, _WHERE)
+__getattr__, __dir__, __all__ = attach_stub(__name__, __file__)

@@ -4,14 +4,6 @@ job (``job_pictures``), log axes (``log_axis``), and the jobs of ``srarap render
 plot`` (``jobs``: :class:`~.jobs.RenderJob`, :func:`~.jobs.run_render`, :class:`~.jobs.PlotJob`,
 :func:`~.jobs.run_plot`). Names are imported on first use.
 """
-from ...runtime.lazy_names import lazy_getattr
+from ...runtime.lazy_names import attach_stub
 
-_WHERE = {"RenderJob": "jobs", "run_render": "jobs", "PlotJob": "jobs", "run_plot": "jobs",
-          "VIEWS": "render", "render_png": "render", "preview_png": "preview",
-          "difference_picture": "job_pictures",
-          "energy_picture": "job_pictures", "shape_picture": "job_pictures"}
-
-__all__ = sorted(_WHERE)
-
-
-__getattr__ = lazy_getattr(__name__, _WHERE)
+__getattr__, __dir__, __all__ = attach_stub(__name__, __file__)
