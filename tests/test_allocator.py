@@ -11,7 +11,7 @@ from helpers import ROOT
 CHILD = """
 import ctypes, sys
 import numpy as np
-from srarap_cli.runtime.allocator import keep_freed_memory
+from srarap_cli.runtime.allocator import keep_freed_memory, own_process
 
 class Info(ctypes.Structure):  # glibc's struct mallinfo2
     _fields_ = [(name, ctypes.c_size_t) for name in
@@ -21,6 +21,7 @@ class Info(ctypes.Structure):  # glibc's struct mallinfo2
 info = ctypes.CDLL(None).mallinfo2
 info.restype = Info
 if sys.argv[1] == "keep":
+    own_process()  # a command's process: the policy applies
     assert keep_freed_memory()
 a = np.ones(100 << 17)  # 100 MB
 mapped = info().hblkhd
@@ -46,9 +47,9 @@ def test_a_large_array_comes_from_the_heap_and_stays_for_reuse():
 ARENAS = """
 import ctypes, sys, threading
 import numpy as np
-from srarap_cli.runtime.allocator import one_arena
+from srarap_cli.runtime.allocator import own_process
 if sys.argv[1] == "one":
-    assert one_arena()
+    assert own_process()
 held = []
 thread = threading.Thread(target=lambda: held.append(np.ones(1 << 17)))  # 1 MB from it
 thread.start()
@@ -83,3 +84,39 @@ def test_a_solve_gives_the_same_bytes_with_memory_kept():
                              capture_output=True, text=True, check=True)
         outs.append(out.stdout)
     assert outs[0] == outs[1] and len(outs[0]) > 60
+
+
+def test_the_python_api_leaves_its_callers_allocator_alone_and_a_command_sets_it(tmp_path):
+    """Issue 72: the one-arena and keep-freed-memory settings were applied from the
+    pipeline that the public ``deform_mesh`` calls. In a fresh process: ``deform``,
+    ``deform_mesh`` and ``Deformer`` call no mallopt; ``srarap deform`` does (each call is
+    written to a file: the command ends its process without Python's exit handlers)."""
+    calls = tmp_path / "calls.txt"
+    code = f"""
+import os, sys
+from srarap_cli.runtime import allocator
+def mallopt(param, value):
+    with open({str(calls)!r}, "a") as fh:
+        fh.write(f"{{param}}\\n")
+    return 1
+allocator._mallopt = lambda: mallopt
+import numpy as np
+import srarap_cli
+bar = srarap_cli.read_mesh(os.path.join({ROOT!r}, "sample_meshes", "bar.obj"))
+twist = os.path.join({ROOT!r}, "configs", "bar-twist.yaml")
+srarap_cli.deform(bar, twist)
+srarap_cli.deform_mesh(bar, srarap_cli.load_handles(twist, bar.vertices))
+V, F = bar.vertices, bar.triangles()[0]
+srarap_cli.Deformer(V, F, np.array([0, 1, 2])).solve(V[[0, 1, 2]])
+with open({str(calls)!r}, "a") as fh:
+    fh.write("api done\\n")
+from srarap_cli.entry import main
+sys.argv = ["srarap", "deform", os.path.join({ROOT!r}, "sample_meshes", "bar.obj"), twist,
+            "-o", os.devnull, "-q"]
+main()
+"""
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    lines = calls.read_text().splitlines()
+    assert lines[0] == "api done" and len(lines) >= 5, lines  # one arena, then three more

@@ -17,7 +17,8 @@ from srarap_cli.solver.multires.simplify import simplify_to_subset
 from srarap_cli.solver.oneshot import make_deformer
 from srarap_cli.solver.operators import cell_graph
 from srarap_cli.tasks.batch.run import job_threads
-from srarap_cli.tasks.deform.record import fingerprint
+from srarap_cli.solver.settings import resolve
+from srarap_cli.tasks.fingerprint import fingerprint
 
 
 def _cgroup(tmp_path, membership, files):
@@ -153,11 +154,10 @@ def test_a_batch_divides_the_cpus_among_its_workers(monkeypatch):
 
 
 def test_the_thread_count_is_not_part_of_a_jobs_fingerprint(tmp_path):
-    mesh, handles = (os.path.join(ROOT, "sample_meshes", "bar.obj"),
-                     os.path.join(ROOT, "configs", "bar-twist.yaml"))
-    keys = {fingerprint(mesh, handles, {"tol": 1e-6, "threads": t}, "o.obj") for t in (1, 2, 7)}
+    keys = {fingerprint([b"mesh"], resolve({"tol": 1e-6, "threads": t}), {"output": "o.obj"})
+            for t in (1, 2, 7)}
     assert len(keys) == 1
-    assert fingerprint(mesh, handles, {"tol": 1e-7}, "o.obj") not in keys
+    assert fingerprint([b"mesh"], resolve({"tol": 1e-7}), {"output": "o.obj"}) not in keys
 
 
 @pytest.fixture

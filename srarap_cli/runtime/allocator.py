@@ -12,7 +12,16 @@ that arena for its own reuse: with memory kept, the solve's block threads each h
 free memory beside the main heap's. One arena shared by all threads lets any thread reuse
 what another freed: 1.2M-vertex cylinder, two runs each with one arena (``MALLOC_ARENA_MAX=1``)
 and without, peak resident memory 0.14 GB (2.7%) lower, free memory left in the arenas at the
-peak 0.87-0.88 GB -> 0.18-0.72 GB; the same seconds and output bytes.
+peak 0.87-0.88 GB -> 0.18-0.72 GB; the same seconds and output bytes. (And the 500k-vertex
+bar's multiresolution setup, whose factorizations run in threads: peak 2,646 -> 2,539 MiB,
+the same wall time. Under ``ulimit -v`` each arena also reserves 64-128 MB, and when that
+failed glibc retried on every allocation: libigl's threads spun for minutes, then "cannot
+allocate memory for thread-local data: ABORT"; with one arena a shortage is a MemoryError.)
+
+This is process policy: a ``srarap`` command owns its process (:func:`own_process`, at its
+start, and in a batch's worker processes), and only then do :func:`one_arena` and
+:func:`keep_freed_memory` act. Called through the Python API (``deform``, ``deform_mesh``,
+``Deformer``), where the process is its caller's, they do nothing.
 """
 import ctypes
 
@@ -33,11 +42,22 @@ def _mallopt():
     return mallopt
 
 
+_owned = False
+
+
+def own_process() -> bool:
+    """This process is a command's (``srarap``'s, or a batch worker's): the allocator policy
+    applies from now on, one arena at once. Returns whether glibc took it."""
+    global _owned
+    _owned = True
+    return one_arena()
+
+
 def one_arena() -> bool:
-    """Have every thread allocate from the main arena (arenas made before stay in use). For
-    the commands, before their setup starts its threads; never the Python API. Returns
-    whether glibc took the setting."""
-    mallopt = _mallopt()
+    """Have every thread allocate from the main arena (arenas made before stay in use): in a
+    command's process (:func:`own_process`), before its setup starts threads; nothing
+    otherwise. Returns whether glibc took the setting."""
+    mallopt = _mallopt() if _owned else None
     return mallopt is not None and mallopt(_M_ARENA_MAX, 1) == 1
 
 
@@ -45,9 +65,9 @@ def keep_freed_memory() -> bool:
     """Serve large allocations from the heap and keep what is freed for reuse (no mmap per
     allocation, no trimming). Process-wide, so called by the commands' tasks once their
     setup is done (deform, animate, and each batch job, also in a Dask worker), never by the
-    Python API, which leaves its caller's process alone. Returns whether glibc took the
-    settings."""
-    mallopt = _mallopt()
+    Python API, which leaves its caller's process alone (nothing unless :func:`own_process`
+    was called). Returns whether glibc took the settings."""
+    mallopt = _mallopt() if _owned else None
     if mallopt is None:
         return False
     settings = ((_M_MMAP_MAX, 0), (_M_TRIM_THRESHOLD, 2**31 - 1), (_M_TOP_PAD, _TOP_PAD))

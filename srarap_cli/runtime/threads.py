@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar, cast
 
+from .allocator import own_process
 from .environment import environ_changed
 from .signals import deferred
 
@@ -88,33 +89,11 @@ def _release_blas_control():
 def pin_process() -> None:
     """Ask the BLAS libraries for one thread before they load (the command line calls this
     first; libraries already loaded keep their pools, which :func:`single_threaded` limits),
-    and keep every thread's allocations in one malloc arena."""
+    and take the process's allocator policy (:func:`..allocator.own_process`: the command
+    owns its process)."""
     for name in _VARIABLES:
         os.environ[name] = "1"
-    _one_malloc_arena()
-
-
-# glibc's mallopt parameter M_ARENA_MAX
-_M_ARENA_MAX = -8
-
-
-def _one_malloc_arena():
-    """glibc gives each new thread its own malloc arena, and memory freed in one arena serves
-    only allocations made there. A multiresolution setup runs its full-resolution
-    factorization in a thread beside the coarse level's (a thread of its own in turn), and
-    the solve that follows reuses less of what they freed: the 500k-vertex bar's peak was
-    2,646 MiB with the default arenas against 2,539 MiB with one, for the same wall time
-    (farm-bench, 3 pairs, ratio 0.9995). Under an address-space limit (``ulimit -v``) each
-    arena also reserves 64-128 MB, and when that fails glibc retries on every allocation
-    (seen: libigl's worker threads spinning in system time for minutes, then "cannot
-    allocate memory for thread-local data: ABORT"); with one arena a real shortage is a
-    MemoryError."""
-    try:
-        import ctypes
-
-        ctypes.CDLL(None).mallopt(_M_ARENA_MAX, 1)
-    except (OSError, AttributeError):  # not glibc: no per-thread arenas to bound
-        pass
+    own_process()
 
 
 def background(func: Callable[[], T]) -> Callable[[], T]:

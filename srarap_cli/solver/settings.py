@@ -68,6 +68,10 @@ class Setting:
     method: str | None = None
     metavar: str | None = None
     default_text: str | None = None
+    #: whether the setting changes what a run writes (the thread count does not: the bytes
+    #: are the same at any count; nor ``strict``/``allow``, which judge its warnings): what a
+    #: fingerprint hashes (:mod:`srarap_cli.tasks.fingerprint`)
+    decides: bool = True
 
     @property
     def flag(self) -> str:
@@ -160,7 +164,8 @@ SETTINGS = (
     Setting("threads", "count", None,
             "Threads for one solve; any count gives byte-identical results (batch divides "
             "the CPUs among its workers).", "solve", minimum=1, metavar="N",
-            default_text="$SRARAP_THREADS, else the CPUs this process may use"),
+            default_text="$SRARAP_THREADS, else the CPUs this process may use",
+            decides=False),
     Setting("multires", "size", "auto",
             "Solve on a simplified mesh of N vertices (or P% of them, or a fraction like 0.02) "
             "and carry the result to "
@@ -176,10 +181,10 @@ SETTINGS = (
             "Treat the warnings about the request (an implausible motion, a part moved "
             "rigidly or left at rest, data the output format drops) as errors: exit 4 "
             "listing them; all: the notes on the mesh too (needles, duplicate faces...).",
-            "run", choices=("off", "request", "all")),
+            "run", choices=("off", "request", "all"), decides=False),
     Setting("allow", "codes", (),
             "A warning code that strict accepts (repeatable; see the warning codes).",
-            "run", metavar="CODE"),
+            "run", metavar="CODE", decides=False),
 )
 BY_NAME = {s.name: s for s in SETTINGS}
 DEFAULTS: dict[str, Any] = {s.name: s.default for s in SETTINGS}

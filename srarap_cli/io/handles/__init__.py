@@ -12,7 +12,8 @@ from .parse import (
     load_handles,
     parse_handles,
     referenced_files,
+    solver_settings,
 )
 
 __all__ = ["ANIMATION_KEYS", "Constraints", "TOP_KEYS", "as_constraints", "load_handles", "parse_handles",
-           "referenced_files"]
+           "referenced_files", "solver_settings"]

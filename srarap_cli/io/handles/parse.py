@@ -270,6 +270,20 @@ def _from_sel(path, V):
                        warnings=warnings)
 
 
+def solver_settings(handles: str | os.PathLike) -> dict[str, Any]:
+    """The settings of a handle file's ``solver`` section, parsed; {} for a ``.sel`` file
+    and for a file that cannot be read or parsed (loading it says why)."""
+    handles = str(handles)
+    if handles.lower().endswith(".sel"):
+        return {}
+    try:
+        doc = load_document(handles, "yaml")  # JSON is YAML too
+        spec = doc.get("solver", {}) if isinstance(doc, dict) else {}
+        return parse_mapping(spec, "solver", InputError)
+    except InputError:
+        return {}
+
+
 def referenced_files(handles: str | os.PathLike) -> list[str]:
     """Files a handle file names (``.dmat``, ``.sel``, ``.def``, ...): every string in it that
     is the path of an existing file, relative to the handle file; a ``.sel`` brings its ``.def``."""

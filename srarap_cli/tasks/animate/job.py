@@ -22,9 +22,10 @@ from ...runtime.warning_codes import note
 from ...solver.result import DeformResult
 from ...solver.settings import resolve
 from ...solver.stop import StopReason
+from ..fingerprint import fingerprint
 from ..preflight import check_output_path, read_any_mesh, refuse_overwrite
 from .frame_files import MAX_FRAMES, check_pattern, frame_count, frames_on_disk, remove_stale, suffix
-from .sequence import FRAME_FIELDS, Animator, FrameState, fingerprint, unreached_keys
+from .sequence import FRAME_FIELDS, Animator, FrameState, run_inputs, unreached_keys
 
 #: the resume state, in the frames' folder
 STATE_NAME = ".srarap-animate-state.npz"
@@ -137,8 +138,9 @@ def run_animation(job: AnimateJob, on_frame: Callable[[int, int], None] | None =
                      + [job.log], mesh=job.mesh, handles=job.handles,
                      others=[("resume state", state_path)])
     opts = resolve(constraints.solver, dict(job.settings))
-    run_id = fingerprint(source, (job.handles, *referenced_files(job.handles)), opts,
-                         n_frames, job.fps, job.iters_per_frame, job.pattern)
+    run_id = fingerprint(run_inputs(source, (job.handles, *referenced_files(job.handles))),
+                         opts, {"frames": n_frames, "fps": job.fps, "pattern": job.pattern,
+                                "iters_per_frame": job.iters_per_frame})
     state = _resume_state(state_path, run_id) if job.resume else None
     # what every frame's file loses, and keys no frame shows: said once, errors under strict
     lost = format_mesh(source, suffix(job.pattern))[1] + unreached_keys(

@@ -9,7 +9,6 @@ a median of 3 iterations per frame to the stop, against 9 from the previous fram
 toward its previous value (paper section 6.3), and rotors are kept on the hemisphere of
 their previous value.
 """
-import hashlib
 import io
 import json
 import time
@@ -28,7 +27,6 @@ from ...runtime.warning_codes import note
 from ...solver.quaternion import align_hemisphere, multiply, normalize
 from ...solver.result import DeformResult
 from ...solver.settings import Settings
-from ..deciding import deciding
 from ..pipeline import command_solver, problem, scatter
 
 FRAME_FIELDS = ("frame", "iterations", "membrane", "bending", "total", "converged",
@@ -160,17 +158,13 @@ def _carried(P, R, before):
 _CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
 
 
-def fingerprint(mesh: Mesh, paths: Sequence[str], opts: Settings, *extra: Any) -> str:
-    """Content hash of the mesh as read (a pipe cannot be read twice), the files ``paths``,
-    the resolved settings and anything else that decides the frames (``extra``,
-    JSON-serializable): a resume state belongs to one run."""
-    h = hashlib.sha256()
-    for array in (mesh.vertices, mesh.face_sizes, mesh.face_vertices):
-        h.update(np.ascontiguousarray(array).tobytes())
-    for path in paths:  # a handle file from a pipe too: its bytes as read
-        h.update(hashlib.sha256(document_bytes(path)).digest())
-    h.update(json.dumps([deciding(opts.as_dict()), *extra], sort_keys=True).encode())
-    return h.hexdigest()
+def run_inputs(mesh: Mesh, paths: Sequence[str]) -> list[bytes]:
+    """What an animation's fingerprint (:func:`~..fingerprint.fingerprint`) hashes of its
+    inputs: the mesh as read (a pipe cannot be read twice) and the files ``paths`` (a handle
+    file from a pipe too: its bytes as read)."""
+    arrays = (mesh.vertices, mesh.face_sizes, mesh.face_vertices)
+    return ([np.ascontiguousarray(a).tobytes() for a in arrays]
+            + [document_bytes(path) for path in paths])
 
 
 def unreached_keys(constraints: Constraints, n_frames: int, fps: float | None,

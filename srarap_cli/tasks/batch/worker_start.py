@@ -9,8 +9,11 @@ anywhere else would change that process's signals: only a fork server imports it
 """
 import signal
 
+from ...runtime.allocator import own_process
 from ...runtime.signals import SIGNALS
 from . import run  # noqa: F401  (imported here so that workers start with it)
+
+own_process()  # a worker is the command's process: its allocator policy too
 
 signal.signal(signal.SIGINT, signal.SIG_IGN)
 signal.signal(signal.SIGTERM, signal.SIG_DFL)

@@ -9,7 +9,6 @@ from .job import DeformJob as DeformJob
 from .job import recorded_result as recorded_result
 from .job import run_job as run_job
 from .job import run_job_safely as run_job_safely
-from .record import fingerprint as fingerprint
 from .record import sidecar_path as sidecar_path
 
 __all__: list[str]

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ...io.documents import load_document
+from ...io.handles import solver_settings
 from ...io.mesh.formats import FORMATS, MeshFormat, by_extension, extensions
 from ...io.solve_log import LOG_FORMATS, format_log
 from ...runtime import descriptors, memory
@@ -29,13 +30,14 @@ from ...solver.settings import resolve
 from ...solver.stop import StopReason
 from ..comparison import Expect
 from ..distortion import vertex_distortion
+from ..fingerprint import fingerprint
 from ..info import up_axis
 from ..job_status import JobResult, JobStatus
 from ..pictures import preview_png
 from ..pipeline import deform_mesh, refuse_warnings
 from ..preflight import check_output_path, load_posed, read_any_mesh, refuse_overwrite
 from .golden import check_golden
-from .record import fingerprint, read_record, record_bytes, sidecar_path
+from .record import input_bytes, read_record, record_bytes, sidecar_path
 
 __all__ = ["DeformJob", "JobResult", "JobStatus", "recorded_result", "run_job",
            "run_job_safely"]
@@ -174,7 +176,17 @@ def _check_format_options(fmt, job):
 
 
 def _key(job):
-    return fingerprint(job.mesh, job.handles, job.settings, os.path.basename(job.output))
+    """The job's fingerprint (:mod:`..fingerprint`): its inputs, its settings resolved over
+    the handle file's (a default written out changes nothing), and what it writes."""
+    try:
+        settings = resolve(solver_settings(job.handles), job.settings)
+    except (ValueError, KeyError):  # the run says what is wrong: no record fits it
+        return None
+    return fingerprint(input_bytes(job.mesh, job.handles), settings, {
+        "output": os.path.basename(job.output),
+        "format": None if job.output_format is None else job.output_format.name,
+        "ascii": job.ascii, "distortion": job.write_distortion, "log": job.log,
+        "preview": job.preview, "preview_up": job.preview_up})
 
 
 def recorded_result(job: DeformJob, key: str | None = None) -> JobResult | None:

@@ -1,17 +1,14 @@
 """A job's record beside its output (``<output>.srarap.json``): the fingerprint of everything
 that decides the output and how the job ended, so that a rerun of an unchanged job reports
 that result again without solving."""
-import hashlib
 import json
-from collections.abc import Mapping, Sequence
-from importlib import metadata
+from collections.abc import Sequence
 from typing import Any
 
 from ...io.handles import referenced_files
 from ...io.input_files import read_input_bytes
 from ...runtime.errors import InputError
 from ...solver.stop import StopReason
-from ..deciding import deciding
 
 #: what a record keeps of a job's result
 RECORDED = ("status", "iterations", "energy", "stop", "warnings", "seconds")
@@ -22,18 +19,16 @@ def sidecar_path(output: str) -> str:
     return output + ".srarap.json"
 
 
-def fingerprint(mesh: str, handles: str, settings: Mapping[str, Any], output: str) -> str:
-    """Content hash of the mesh, the handle file and every file it names, the settings, the
-    output's name and srarap's version."""
-    h = hashlib.sha256()
+def input_bytes(mesh: str, handles: str) -> list[bytes]:
+    """The bytes of the mesh, the handle file and every file it names (a missing one: its
+    name, marked), what a job's fingerprint hashes of its inputs."""
+    out = []
     for path in (mesh, handles, *referenced_files(handles)):
         try:
-            h.update(hashlib.sha256(read_input_bytes(path)).digest())
+            out.append(read_input_bytes(path))
         except InputError:
-            h.update(b"missing:" + path.encode("utf-8", "surrogateescape"))
-    h.update(json.dumps([deciding(settings), output, metadata.version("srarap-cli")],
-                        sort_keys=True).encode())
-    return h.hexdigest()
+            out.append(b"missing:" + path.encode("utf-8", "surrogateescape"))
+    return out
 
 
 def read_record(sidecar: str, key: str) -> dict[str, Any] | None:
