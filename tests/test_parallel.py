@@ -16,8 +16,8 @@ from srarap_cli.solver import linalg, one_triangle, operators
 from srarap_cli.solver.multires.simplify import simplify_to_subset
 from srarap_cli.solver.oneshot import make_deformer
 from srarap_cli.solver.operators import cell_graph
-from srarap_cli.tasks.batch.run import job_threads
 from srarap_cli.solver.settings import resolve
+from srarap_cli.tasks.batch.run import job_threads
 from srarap_cli.tasks.fingerprint import fingerprint
 
 

@@ -45,7 +45,7 @@ def test_binary_stl_and_ascii_ply_read_back_as_written(tmp_path):
     assert len(stl.face_sizes) == len(F)
     np.testing.assert_allclose(stl.vertices[stl.face_vertices].reshape(-1, 3),
                                obj.vertices[F].reshape(-1, 3), atol=1e-6)  # float32
-    assert b"STL keeps only triangles" in s.stderr
+    assert b"written as triangles (STL keeps triangles)" in s.stderr
 
 
 def test_ascii_applies_to_ply_only(tmp_path):

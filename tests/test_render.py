@@ -327,3 +327,17 @@ def test_the_rest_shape_may_come_from_standard_input(tmp_path):
     both = CliRunner().invoke(main, ["render", "-", "--rest", "-", "-o", str(by_stdin)],
                               input=rest_file.read_bytes())
     assert both.exit_code == 2 and "both be standard input" in both.stderr
+
+
+def test_a_reduced_face_takes_the_mean_colour_of_the_faces_it_stands_for():
+    """Issue 72: a mutation that gave each clustered face one of its faces' colours passed
+    the quick loop (the tests' colours were uniform away from a seam). Every face twice, a
+    red copy and a blue one: each reduced face stands for both, and is their mix."""
+    from srarap_cli.tasks.pictures.render import display_mesh
+
+    V, F = _dense_tube()
+    twice = np.vstack([F, F])
+    colors = np.repeat(PALETTE[:2], len(F), axis=0)
+    W, G, c, normals = display_mesh(V, twice, colors, 2_000)
+    assert len(G) < len(F) / 4
+    assert np.allclose(c, (PALETTE[0] + PALETTE[1]) / 2)

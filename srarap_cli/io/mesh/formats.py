@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...runtime.warning_codes import coded
+from .keeps import drops
 from .mesh import Mesh
 from .normals import recompute_normals
 from .obj import format_obj, obj_frames, read_obj
@@ -45,8 +46,10 @@ class MeshFormat:
     signature_rank : int, signatures are asked in this order (lowest first): an exact test
         (binary STL's size, PLY's magic line) before one on first words (OFF, OBJ)
     has_ascii : bool, ``--ascii`` applies
-    keeps_vertex_data : bool, other per-vertex properties (``Mesh.vertex_data``) are
-        written (``--write-distortion`` applies)
+    keeps : frozenset of str, the kinds of :data:`.keeps.KINDS` the format writes (quads,
+        polygons, texture coordinates, normals, per-vertex data, OBJ statements); what a
+        mesh holds of the others is said in a warning (:meth:`encode`), so a format that
+        does not declare a kind cannot drop it silently
     frames : callable(mesh) -> callable(positions) -> bytes, optional; the bytes of
         ``mesh`` with other positions, faster than ``write`` per frame (animations)
     """
@@ -60,18 +63,28 @@ class MeshFormat:
     description: str = ""
     signature_rank: int = 50
     has_ascii: bool = False
-    keeps_vertex_data: bool = False
+    keeps: frozenset[str] = frozenset()
     frames: Callable[[Mesh], Callable[[np.ndarray], bytes]] | None = None
 
     @property
     def extension(self) -> str:
         return self.extensions[0]
 
+    @property
+    def keeps_vertex_data(self) -> bool:
+        """Other per-vertex properties (``Mesh.vertex_data``) are written
+        (``--write-distortion`` applies)."""
+        return "vertex_data" in self.keeps
+
     def encode(self, mesh: Mesh, ascii: bool = False) -> Written:
-        """``write``'s bytes and warnings, with a warning for what the file ``mesh`` was read
-        from held and no writer keeps (:attr:`Mesh.unkept`); each one coded ``format-drops``
-        (a plug-in writer's plain lines too), so ``strict`` catches it."""
+        """``write``'s bytes and warnings: the writer's own, one per kind ``mesh`` holds that
+        the format does not keep (:func:`.keeps.drops`, from :attr:`keeps`), and what the
+        file ``mesh`` was read from held and no writer keeps (:attr:`Mesh.unkept`); each one
+        coded ``format-drops``, so ``strict`` catches it."""
         data, lost = self.write(mesh, ascii)
+        keepers = {kind: fmt.extension for fmt in reversed(FORMATS.values())
+                   for kind in fmt.keeps}
+        lost = drops(mesh, self.name.upper(), self.keeps, keepers) + lost
         if mesh.unkept:
             lost = lost + [f"not written: {'; '.join(mesh.unkept)} of the input (srarap "
                            "keeps vertices, faces and per-vertex properties)"]
@@ -202,37 +215,27 @@ def _write_obj(mesh: Mesh, ascii: bool) -> Written:
 
 
 def _write_stl(mesh: Mesh, ascii: bool) -> Written:
-    lost = []
-    if (mesh.face_sizes != 3).any() or mesh.uv is not None or mesh.normals is not None:
-        lost.append("STL keeps only triangles in single precision: polygons split, "
-                    "texture coordinates and normals not written, vertices not shared")
-    return format_stl(mesh), lost
+    return format_stl(mesh), []
 
 
-def _per_vertex_only(mesh: Mesh, name: str) -> tuple[Mesh, list[str]]:
-    """``mesh`` as a format with at most one texture coordinate and normal per vertex can
-    hold it: per-corner normals averaged per vertex, a warning for lost coordinates."""
-    lost = []
-    if mesh.uv is not None and (name == "off" or per_vertex(mesh, mesh.uv, mesh.face_uv) is None):
-        lost.append(f"texture coordinates not written: {name.upper()} stores at most one "
-                    "per vertex; write .obj to keep them")
-    if mesh.normals is not None and per_vertex(mesh, mesh.normals, mesh.face_normals) is None:
-        out = Mesh(**{k: getattr(mesh, k) for k in mesh.__dataclass_fields__})
-        out.normals = np.zeros_like(mesh.vertices)
-        out.face_normals = mesh.face_vertices
-        out.normals = recompute_normals(out)
-        mesh = out
-    return mesh, lost
+def _per_vertex_normals(mesh: Mesh) -> Mesh:
+    """``mesh`` as a format with at most one normal per vertex holds it: per-corner normals
+    averaged per vertex."""
+    if mesh.normals is None or per_vertex(mesh, mesh.normals, mesh.face_normals) is not None:
+        return mesh
+    out = Mesh(**{k: getattr(mesh, k) for k in mesh.__dataclass_fields__})
+    out.normals = np.zeros_like(mesh.vertices)
+    out.face_normals = mesh.face_vertices
+    out.normals = recompute_normals(out)
+    return out
 
 
 def _write_off(mesh: Mesh, ascii: bool) -> Written:
-    mesh, lost = _per_vertex_only(mesh, "off")
-    return format_off(mesh).encode("ascii"), lost
+    return format_off(_per_vertex_normals(mesh)).encode("ascii"), []
 
 
 def _write_ply(mesh: Mesh, ascii: bool) -> Written:
-    mesh, lost = _per_vertex_only(mesh, "ply")
-    return format_ply(mesh, ascii), lost
+    return format_ply(_per_vertex_normals(mesh), ascii), []
 
 
 # Measured on this project's machines (README, "Limits"): parsing text meshes holds about 17x
@@ -240,15 +243,17 @@ def _write_ply(mesh: Mesh, ascii: bool) -> Written:
 register_format(MeshFormat(
     "obj", (".obj",), read_obj, _write_obj, 20, _is_obj,
     "polygons, texture coordinates, normals and statements (`mtllib`, `usemtl`, `g`, `s`) "
-    "kept", signature_rank=90, frames=obj_frames))
+    "kept", signature_rank=90, frames=obj_frames,
+    keeps=frozenset({"quads", "polygons", "uv", "uv_seams", "normals", "statements"})))
 register_format(MeshFormat(
     "off", (".off",), read_off, _write_off, 20, _is_off,
-    "ASCII, with the NOFF/COFF/STOFF prefixes; per-vertex normals kept", signature_rank=80))
+    "ASCII, with the NOFF/COFF/STOFF prefixes; per-vertex normals kept", signature_rank=80,
+    keeps=frozenset({"quads", "polygons", "normals"})))
 register_format(MeshFormat(
     "ply", (".ply",), read_ply, _write_ply, 6, _is_ply,
     "binary (default) or ASCII (`--ascii`); per-vertex normals, texture coordinates and "
     "other per-vertex properties kept", signature_rank=10, has_ascii=True,
-    keeps_vertex_data=True))
+    keeps=frozenset({"quads", "polygons", "uv", "normals", "vertex_data"})))
 register_format(MeshFormat(
     "stl", (".stl",), read_stl, _write_stl, 6, _is_stl,
     "binary or ASCII in, binary out; corners welded into shared vertices on reading, "

@@ -138,7 +138,9 @@ def register_meshio_formats() -> list[str]:
         register_format(MeshFormat(
             name, spec.extensions, _reader(spec.meshio or name, spec),
             _writer(spec.meshio or name, spec), 20, _never, _description(spec),
-            signature_rank=100, keeps_vertex_data=spec.keeps_data))
+            signature_rank=100,
+            keeps=frozenset({"quads"} if spec.quads else set())
+            | ({"vertex_data"} if spec.keeps_data else set())))
     return added
 
 
@@ -260,15 +262,8 @@ def _writer(name, spec):
     def write(mesh: Mesh, ascii: bool) -> Written:
         import meshio
 
-        cells, lost = _cells(mesh, spec.quads)
-        lost += [f"{what} not written: {spec.display} keeps positions, faces and point data; "
-                 "write .obj to keep them" for what, kept in
-                 (("texture coordinates", mesh.uv), ("normals", mesh.normals))
-                 if kept is not None]
+        cells = _cells(mesh, spec.quads)  # what it drops is said from the format's keeps
         data = {k: np.asarray(v) for k, v in mesh.vertex_data.items()} if spec.keeps_data else {}
-        if mesh.vertex_data and not spec.keeps_data:
-            lost.append(f"per-vertex data ({', '.join(sorted(mesh.vertex_data))}) not written: "
-                        f"{spec.display} keeps positions and faces; write .vtu to keep it")
         out = meshio.Mesh(mesh.vertices, cells, point_data=data)
         extension = spec.extensions[0].removesuffix(".gz")
         try:
@@ -284,16 +279,16 @@ def _writer(name, spec):
             raise OutputError(f"{tempfile.gettempdir()}: cannot write the {spec.display} file "
                               f"meshio makes there ({exc.strerror or exc}); set TMPDIR to a "
                               "folder with room") from None
-        return (gzip.compress(content, mtime=0) if spec.gzip else content), lost
+        return (gzip.compress(content, mtime=0) if spec.gzip else content), []
     return write
 
 
 def _cells(mesh, quads=True):
     """Triangles, then quads (a mixed mesh's faces come back in that order); the larger
     polygons alone, and quads where the format keeps none, split into triangles (a fan from
-    each one's first corner, after the mesh's own triangles), with a warning that counts
-    them: one pentagon among quads turned every quad into two triangles."""
-    sizes, lost = mesh.face_sizes, []
+    each one's first corner, after the mesh's own triangles): one pentagon among quads
+    turned every quad into two triangles."""
+    sizes = mesh.face_sizes
     largest = 4 if quads else 3
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     split = np.flatnonzero(sizes > largest)
@@ -302,17 +297,13 @@ def _cells(mesh, quads=True):
         rows = split[sizes[split] == size]
         corners = _faces_of(mesh, offsets, rows, int(size))
         triangles += [corners[:, [0, k, k + 1]] for k in range(1, int(size) - 1)]
-    if split.size:
-        kind = "polygons of more than 4 corners" if quads else "quads and larger polygons"
-        lost.append(f"{split.size} {kind} written as triangles (the format keeps "
-                    f"{'triangles and quads' if quads else 'triangles'})")
     cells = []
     tris = np.concatenate(triangles) if len(triangles) > 1 else triangles[0]
     if len(tris):
         cells.append(("triangle", tris))
     if quads and (sizes == 4).any():
         cells.append(("quad", _faces_of(mesh, offsets, np.flatnonzero(sizes == 4), 4)))
-    return cells, lost
+    return cells
 
 
 def _faces_of(mesh, offsets, rows, size):
