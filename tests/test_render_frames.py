@@ -114,3 +114,30 @@ def test_a_frame_that_cannot_be_read_in_a_drawing_process_is_one_line(frames, tm
     r = render(broken, "-o", tmp_path / "s.png")
     assert r.exit_code == 4 and len(r.stderr.splitlines()) == 1, r.stderr
     assert "f_01.obj" in r.stderr and not (tmp_path / "s.png").exists()
+
+
+def test_frames_read_by_their_positions_are_the_meshes_read_whole(frames, tmp_path):
+    """read_frames parses a later OBJ frame's positions alone when its face lines are the
+    first's; what it gives is what read_mesh gives (normals aside), and a frame with other
+    faces, or a bad position, is read and checked whole."""
+    from srarap_cli.io.mesh import read_frames, read_mesh
+    paths = [frames.format(k) for k in range(5)]
+    for parts in (1, 2):
+        for fast, whole in zip(read_frames(paths, parts), map(read_mesh, paths)):
+            assert np.array_equal(fast.vertices, whole.vertices)
+            assert np.array_equal(fast.face_vertices, whole.face_vertices)
+            assert np.array_equal(fast.face_sizes, whole.face_sizes)
+    other = tmp_path / "f_01.obj"  # the same positions, one face turned the other way
+    text = open(paths[1]).read()
+    first_face = next(line for line in text.splitlines() if line.startswith("f "))
+    corners = first_face.split()[1:]
+    other.write_text(text.replace(first_face, "f " + " ".join(reversed(corners)), 1))
+    got = read_frames([paths[0], str(other)])[1]
+    assert np.array_equal(got.face_vertices, read_mesh(str(other)).face_vertices)
+    bad = tmp_path / "f_02.obj"
+    lines = text.splitlines()
+    k = next(i for i, line in enumerate(lines) if line.startswith("v "))
+    lines[k] = "v nan 0 0"
+    bad.write_text("\n".join(lines) + "\n")
+    with pytest.raises(Exception, match="f_02.obj: vertex 0 has a NaN"):
+        read_frames([paths[0], str(bad)], 2)

@@ -2,17 +2,19 @@
 import contextlib
 import os
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import replace
 
 import numpy as np
 
-from ...runtime.bounded import OutOfMemory, OutOfTime, start_bounded, time_bound
+from ...runtime.bounded import OutOfMemory, OutOfTime, map_forked, start_bounded, time_bound
 from ...runtime.commit import atomic_write
 from ...runtime.errors import InputError, OutputError
 from ...runtime.limits import MAX_COORDINATE, check_read
 from .formats import HEAD_BYTES, MeshFormat, by_content, by_extension, extensions, suffix_of
 from .mesh import Mesh
 from .meshio_formats import needs
+from .obj import obj_faces_and_positions
 from .sniff import not_a_mesh
 from .stream import read_mesh_stream
 
@@ -32,6 +34,31 @@ def read_mesh(path: str | os.PathLike, fmt: MeshFormat | None = None) -> Mesh:
     TypeError : ``path`` is not a path.
     """
     return open_mesh(path, fmt)[0]
+
+
+def read_frames(paths: Sequence[str], parts: int = 1) -> list[Mesh]:
+    """The meshes of an animation's frames, in ``parts`` processes (a parse holds the GIL):
+    the first read whole, and each later OBJ frame whose face lines are the first's by its
+    positions alone (:func:`.obj.obj_faces_and_positions`; checked as :func:`read_mesh`
+    checks positions), its faces, texture coordinates and statements the first's and its
+    normals left out; any other frame read whole.
+
+    Raises InputError as :func:`read_mesh` does, naming the frame's file.
+    """
+    first = read_mesh(paths[0])
+    simple = obj_faces_and_positions(paths[0]) if suffix_of(paths[0]) == ".obj" else None
+    faces = None if simple is None else simple[0]
+
+    def one(path):
+        got = obj_faces_and_positions(path) if faces and suffix_of(path) == ".obj" else None
+        if got is None or got[0] != faces or len(got[1]) != len(first.vertices):
+            return read_mesh(path)
+        _validate(replace(first, vertices=got[1]), path)
+        return got[1]
+    seconds = time_bound(sum(os.path.getsize(p) for p in paths if os.path.isfile(p)))
+    rest = map_forked(one, list(paths[1:]), parts, seconds)
+    return [first] + [replace(first, vertices=r, normals=None, face_normals=None)
+                      if isinstance(r, np.ndarray) else r for r in rest]
 
 
 @contextlib.contextmanager

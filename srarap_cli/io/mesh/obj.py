@@ -50,6 +50,21 @@ def read_obj(path: str) -> Mesh:
     return _read_bulk(text) or _read_general(text, path)
 
 
+def obj_faces_and_positions(path: str) -> tuple[str, np.ndarray] | None:
+    """The text of an OBJ file's face lines (as one block) and its positions (n, 3), the
+    positions alone parsed: an animation's frames share their faces, and a frame whose face
+    lines are the first's needs only its positions read (25 frames of a 5.8k-vertex mesh
+    with texture coordinates: 2.7 -> 0.5 s). None for a file the bulk reader would not take
+    whole (line continuations, other line breaks, a position of other than 3 numbers)."""
+    with open_input(path, encoding="utf-8", errors="replace") as fh:
+        text = fh.read()
+    if "\\" in text or any(c in text for c in _ODD_BREAKS) or \
+            ("\r" in text and text.count("\r") != text.count("\r\n")):
+        return None
+    V = _rows_of(*_block(text, "v"), 3)
+    return None if V is None else (_block(text, "f")[0], V)
+
+
 _HEADS = ("v", "vt", "vn", "f")
 # a line that is none of "v ", "vt ", "vn ", "f ", a comment or blank: a statement to keep
 _OTHER = re.compile(r"^(?!(?:v|vt|vn|f) |#|[ \t\r]*$).*$", re.M)

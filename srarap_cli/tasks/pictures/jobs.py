@@ -9,10 +9,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...io.handles import load_handles
-from ...io.mesh import read_mesh, reading_beside
+from ...io.mesh import read_frames, reading_beside
 from ...io.mesh.formats import MeshFormat
 from ...io.solve_log import read_log
-from ...runtime.bounded import map_forked, time_bound
 from ...runtime.commit import commit_files
 from ...runtime.errors import InputError, UsageProblem
 from ...runtime.parallel import available_cpus
@@ -141,8 +140,7 @@ def _frames(job, on_note):
     numbers = list(range(len(paths))) if gif else sheet_choice(len(paths))
     # a sheet reads only the frames it draws; parsing and drawing hold the GIL: processes
     parts = available_cpus()
-    meshes = map_forked(read_mesh, [paths[k] for k in numbers], parts,
-                        time_bound(sum(os.path.getsize(paths[k]) for k in numbers)))
+    meshes = read_frames([paths[k] for k in numbers], parts)
     if any(len(m.vertices) != len(meshes[0].vertices) for m in meshes):
         raise InputError(f"{job.mesh}: the frames do not all have the same vertices")
     constraints = (load_handles(job.handles, meshes[0].vertices, any_rate=True)
