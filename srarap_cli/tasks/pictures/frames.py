@@ -1,6 +1,7 @@
 """An animation's frames as one picture: an animated GIF, or a contact sheet of thumbnails."""
 import io
 import math
+import os
 from collections.abc import Sequence
 
 import numpy as np
@@ -8,7 +9,8 @@ import numpy as np
 from ...io.handles import Constraints
 from ...io.mesh.mesh import Mesh
 from ...runtime.bounded import map_forked
-from .preview import preview_png
+from .preview import frame_canvas, preview_parts
+from .render import Canvas
 
 #: a contact sheet shows at most this many frames (evenly spread, first and last included)
 SHEET_FRAMES = 24
@@ -35,10 +37,21 @@ def frame_pictures(meshes: Sequence[Mesh], numbers: Sequence[int],
     lo, hi = corners[:, 0].min(axis=0), corners[:, 1].max(axis=0)
     box = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
                     for z in (lo[2], hi[2])])
-    return map_forked(lambda k: preview_png(meshes[k], None, constraints, view=view,
-                                            size=size, up=up, framed=box,
-                                            caption=f"frame {numbers[k]}"),
-                      list(range(len(meshes))), parts, DRAW_SECONDS * len(meshes))
+    canvases: dict[int, Canvas] = {}  # one a process (a part is forked before it draws)
+
+    def picture(k):
+        panels, note, setup = preview_parts(meshes[k], None, constraints, up=up,
+                                            caption=f"frame {numbers[k]}")
+        canvas = canvases.get(os.getpid())
+        if canvas is None:
+            canvas = canvases[os.getpid()] = frame_canvas(setup, size, view, box)
+        return canvas.png(panels, note)
+    try:
+        return map_forked(picture, list(range(len(meshes))), parts,
+                          DRAW_SECONDS * len(meshes))
+    finally:
+        for canvas in canvases.values():
+            canvas.close()
 
 
 def animated_gif(pictures: Sequence[bytes], fps: float = 12.0) -> bytes:

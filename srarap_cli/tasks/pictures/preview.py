@@ -1,13 +1,14 @@
 """A picture of a deformed mesh: rest and deformed shape, handles coloured or strain mapped."""
 from collections.abc import Sequence
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
 from ...io.handles import Constraints
 from ...io.mesh.mesh import Mesh
 from ..distortion import vertex_distortion
-from .render import face_colors, group_colors, render_png
+from .render import Canvas, face_colors, group_colors, render_png
 
 #: Proper rotations taking each axis name to +z, the renderer's up.
 UP = {"z": np.eye(3), "-z": np.diag([1.0, -1, -1]),
@@ -29,6 +30,27 @@ def preview_png(mesh: Mesh, rest: Mesh | None = None, constraints: Constraints |
     ``up`` names the mesh's axis drawn upward (OBJ's convention, y, by default); ``framed``
     (p, 3): points the picture's frame holds too (model coordinates); ``caption``: a text
     before the extent at the bottom."""
+    picture = preview_parts(mesh, rest, constraints, color, layout, up, caption)
+    panels, note, setup = picture
+    return render_png(panels, size, view, setup["colorbar"], legend=setup["legend"],
+                      axes=setup["axes"], note=note, titles=setup["titles"],
+                      framed=None if framed is None else framed @ setup["axes"])
+
+
+def frame_canvas(setup: dict, size: tuple[int, int], view: str,
+                 framed: np.ndarray | None) -> Canvas:
+    """The :class:`~.render.Canvas` that draws the frames of one animation (their
+    :func:`preview_parts` alike but for the meshes and the note), for :meth:`Canvas.png`."""
+    return Canvas(1, size, view, setup["colorbar"], setup["legend"], setup["axes"],
+                  setup["titles"], None if framed is None else framed @ setup["axes"])
+
+
+def preview_parts(mesh: Mesh, rest: Mesh | None = None,
+                  constraints: Constraints | None = None, color: str = "shade",
+                  layout: str = "ghost", up: str = "y", caption: str | None = None
+                  ) -> tuple[list, str, dict[str, Any]]:
+    """What :func:`preview_png` draws: its panels, its note, and what the figure is made of
+    (``colorbar``, ``legend``, ``axes``: the turn to the renderer's frame, ``titles``)."""
     turn = UP[up].T
     mesh = _turned(mesh, turn)
     rest = None if rest is None else _turned(rest, turn)
@@ -61,8 +83,8 @@ def preview_png(mesh: Mesh, rest: Mesh | None = None, constraints: Constraints |
     legend = list(constraints.groups) if constraints is not None and color != "distortion" \
         else None
     titles = ["rest", "deformed"] if len(panels) == 2 else None
-    return render_png(panels, size, view, colorbar, legend=legend, axes=turn, note=note,
-                      titles=titles, framed=None if framed is None else framed @ turn)
+    return panels, note, {"colorbar": colorbar, "legend": legend, "axes": turn,
+                          "titles": titles}
 
 
 def _painter(F, groups):

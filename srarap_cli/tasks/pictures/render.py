@@ -288,62 +288,95 @@ def render_png(panels: list, size: tuple[int, int] = (800, 600),
     framed : (p, 3) float array, optional, points the view's frame also holds (the frames of
         an animation framed alike: every frame's extent)
     """
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.cm import ScalarMappable
-    from matplotlib.colors import Normalize
+    canvas = Canvas(len(panels), size, view, colorbar, legend, axes, titles, framed)
+    try:
+        return canvas.png(panels, note)
+    finally:
+        canvas.close()
 
-    dpi = 100
-    fig = plt.figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
-    # the colour bar and its labels take about 90 pixels, whatever the picture's width
-    width = 1.0 - min(0.4, 90 / size[0]) if colorbar else 1.0
-    triad = axes
-    views = [view] if isinstance(view, str) else list(view)
-    columns = len(views) * len(panels)
-    labelled = bool(titles) or len(views) > 1
-    top = 0.92 if labelled else 1.0  # room above the panels for their labels
-    # every mesh once, reduced to what its panel's pixels can show
-    budget = int(FACES_PER_PIXEL * size[0] * width / columns * size[1] * top)
-    shown = [[(display_mesh(V, F, c, budget), a) for V, F, c, a in meshes]
-             for meshes in panels]
-    for v, name in enumerate(views):
-        boxes, axes = [], []
-        for k in range(len(panels)):
-            col = v * len(panels) + k
-            ax = fig.add_axes((col * width / columns, 0, width / columns, top))
-            ax.set_axis_off()
-            boxes += [draw(ax, V, F, c, name, a, normals)
-                      for (V, F, c, normals), a in shown[k]]
-            axes.append(ax)
-            label = ", ".join(([titles[k]] if titles else []) + ([name] if len(views) > 1
-                                                                 else []))
-            if label:
-                fig.text((col + 0.5) * width / columns, 0.965, label, ha="center", va="top",
-                         fontsize=9, color="0.2")
-        if framed is not None:
-            _, up, right = camera(name)
-            x, y = framed @ right, framed @ up
-            boxes.append((x.min(), x.max(), y.min(), y.max()))
-        _frame(axes, boxes)
-        if triad is not None:
-            _triad(fig, v * len(panels) * width / columns, name, triad)
-    if colorbar:
-        cax = fig.add_axes((width + 0.1 * (1 - width), 0.12, 0.022 * 800 / size[0], 0.76))
-        bar = fig.colorbar(ScalarMappable(Normalize(0, colorbar[1]), "viridis"), cax=cax)
-        bar.set_label(colorbar[0], fontsize=7, labelpad=2)
-        bar.ax.tick_params(labelsize=7)
-        from matplotlib.ticker import FuncFormatter
-        bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
-        bar.ax.yaxis.get_offset_text().set_visible(False)
-    if legend:
-        from matplotlib.patches import Patch
-        fig.legend(handles=[Patch(color=PALETTE[k % len(PALETTE)], label=text)
-                            for k, text in enumerate(legend)], loc="upper left", fontsize=8,
-                   frameon=False)
-    if note:
-        fig.text(0.01, 0.01, note, fontsize=7, color="0.3")
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi, metadata={"Software": None})
-    plt.close(fig)
-    return buf.getvalue()
+
+class Canvas:
+    """The figure of :func:`render_png` without its meshes and note, to draw again and again
+    (an animation's frames: the axes, triad, legend and colour bar made once, which was half
+    of a frame's drawing). :meth:`png` draws the panels' meshes and the note, saves, and
+    takes them off again; the bytes are those :func:`render_png` gives."""
+
+    def __init__(self, n_panels: int, size: tuple[int, int] = (800, 600),
+                 view: str | Sequence[str] = "iso", colorbar: Any = None,
+                 legend: Any = None, axes: Any = None, titles: Sequence[str] | None = None,
+                 framed: np.ndarray | None = None) -> None:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        from matplotlib.cm import ScalarMappable
+        from matplotlib.colors import Normalize
+
+        self.dpi = 100
+        self.fig = fig = plt.figure(figsize=(size[0] / self.dpi, size[1] / self.dpi),
+                                    dpi=self.dpi)
+        # the colour bar and its labels take about 90 pixels, whatever the picture's width
+        width = 1.0 - min(0.4, 90 / size[0]) if colorbar else 1.0
+        self.views = views = [view] if isinstance(view, str) else list(view)
+        columns = len(views) * n_panels
+        labelled = bool(titles) or len(views) > 1
+        top = 0.92 if labelled else 1.0  # room above the panels for their labels
+        self.budget = int(FACES_PER_PIXEL * size[0] * width / columns * size[1] * top)
+        self.framed = framed
+        self.axes: list[list[Any]] = []
+        for v, name in enumerate(views):
+            row = []
+            for k in range(n_panels):
+                col = v * n_panels + k
+                ax = fig.add_axes((col * width / columns, 0, width / columns, top))
+                ax.set_axis_off()
+                row.append(ax)
+                label = ", ".join(([titles[k]] if titles else [])
+                                  + ([name] if len(views) > 1 else []))
+                if label:
+                    fig.text((col + 0.5) * width / columns, 0.965, label, ha="center",
+                             va="top", fontsize=9, color="0.2")
+            self.axes.append(row)
+            if axes is not None:
+                _triad(fig, v * n_panels * width / columns, name, axes)
+        if colorbar:
+            cax = fig.add_axes((width + 0.1 * (1 - width), 0.12, 0.022 * 800 / size[0], 0.76))
+            bar = fig.colorbar(ScalarMappable(Normalize(0, colorbar[1]), "viridis"), cax=cax)
+            bar.set_label(colorbar[0], fontsize=7, labelpad=2)
+            bar.ax.tick_params(labelsize=7)
+            from matplotlib.ticker import FuncFormatter
+            bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
+            bar.ax.yaxis.get_offset_text().set_visible(False)
+        if legend:
+            from matplotlib.patches import Patch
+            fig.legend(handles=[Patch(color=PALETTE[k % len(PALETTE)], label=text)
+                                for k, text in enumerate(legend)], loc="upper left",
+                       fontsize=8, frameon=False)
+
+    def png(self, panels: list, note: str | None = None) -> bytes:
+        """PNG bytes of ``panels`` (see :func:`render_png`) with ``note`` at the bottom."""
+        # every mesh once, reduced to what its panel's pixels can show
+        shown = [[(display_mesh(V, F, c, self.budget), a) for V, F, c, a in meshes]
+                 for meshes in panels]
+        drawn = []
+        for name, row in zip(self.views, self.axes):
+            boxes = []
+            for ax, meshes in zip(row, shown):
+                boxes += [draw(ax, V, F, c, name, a, normals)
+                          for (V, F, c, normals), a in meshes]
+                drawn += list(ax.artists)
+            if self.framed is not None:
+                _, up, right = camera(name)
+                x, y = self.framed @ right, self.framed @ up
+                boxes.append((x.min(), x.max(), y.min(), y.max()))
+            _frame(row, boxes)
+        if note:
+            drawn.append(self.fig.text(0.01, 0.01, note, fontsize=7, color="0.3"))
+        buf = io.BytesIO()
+        self.fig.savefig(buf, format="png", dpi=self.dpi, metadata={"Software": None})
+        for artist in drawn:
+            artist.remove()
+        return buf.getvalue()
+
+    def close(self) -> None:
+        import matplotlib.pyplot as plt
+        plt.close(self.fig)
