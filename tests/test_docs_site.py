@@ -100,3 +100,16 @@ def test_a_browser_opens_every_page_without_errors_or_broken_images(site, tmp_pa
     assert shown["./"] >= 1 and shown["guides/handle-files/"] >= 3  # home page, selectors
     assert shown["guides/workflows/"] >= 3
     assert shot.is_file() and shot.stat().st_size > 10_000
+
+
+def test_what_a_program_prints_wraps_and_code_does_not(site):
+    """Issue 70: the stylesheet's rule for program output named ``language-console`` and
+    ``language-text``, classes the built pages did not have (a check of the stylesheet's
+    text passed all the same). The built page's blocks carry their language, which is what
+    the rule selects."""
+    page = (site / "guides" / "regression" / "index.html").read_text(encoding="utf-8")
+    assert 'class="language-console highlight"' in page
+    assert 'class="language-text highlight"' in page
+    assert 'class="language-yaml highlight"' in page
+    css = (site / "stylesheets" / "extra.css").read_text(encoding="utf-8")
+    assert ".md-typeset .language-console pre > code" in css
