@@ -217,7 +217,7 @@ def test_a_link_made_while_the_batch_runs_carries_nothing_outside(tmp_path):
     again when it happens, and the job fails without writing (its mesh and record stay
     out of the other folder)."""
     from srarap_cli.tasks.batch.manifest import check_outputs, load_manifest
-    from srarap_cli.tasks.batch.run import run_batch
+    from srarap_cli.tasks.batch.run import run_jobs
 
     out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
     out.mkdir()
@@ -226,7 +226,7 @@ def test_a_link_made_while_the_batch_runs_carries_nothing_outside(tmp_path):
     jobs = load_manifest(str(manifest))
     check_outputs(jobs, str(out), str(manifest))  # nothing leads out yet
     (out / "sub").symlink_to(elsewhere)           # ... then a link appears
-    rows = {r.job: r for r in run_batch(jobs, str(out))}
+    rows = {r.job: r for r in run_jobs(jobs, str(out))}
     assert rows["j0"].status.value == "ok" and (out / "a.obj").exists()
     assert rows["j1"].status.value == "failed" and "leads out of the output folder" in \
         rows["j1"].message
@@ -248,7 +248,7 @@ def test_the_output_folder_swapped_for_a_link_mid_run_carries_nothing_there(tmp_
 
     def then_swap(job, *args, **kwargs):
         row = real(job, *args, **kwargs)
-        if job["name"] == "j0":
+        if job.name == "j0":
             out.rename(tmp_path / "moved")
             out.symlink_to(elsewhere)
         return row

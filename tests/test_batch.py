@@ -179,3 +179,56 @@ def test_the_codes_allow_accepts_add_up_over_defaults_job_and_command_line(tmp_p
     path = manifest(tmp_path, [job], {"strict": True})  # without it: failed by strict
     r, rows = run(path, tmp_path / "out2", "--allow", "units")
     assert rows["slip"]["status"] == "failed" and "[rigid-part]" in rows["slip"]["message"]
+
+
+def test_a_batch_is_one_frozen_job_and_one_call_from_python(tmp_path):
+    """Issue 72: ``run_batch(BatchJob) -> BatchOutcome``, the path the command takes; the
+    manifest's jobs are typed, with their settings as layers laid in one place."""
+    import dataclasses
+
+    from srarap_cli.tasks.batch import BatchJob, load_manifest, run_batch
+
+    path = manifest(tmp_path, [{"name": "twist", "mesh": BAR, "handles": TWIST,
+                                "output": "twist.obj", "settings": {"allow": ["needles"],
+                                                                   "tol": 1e-5}}],
+                    {"max_iter": 300, "allow": ["units"], "tol": 1e-4})
+    job = load_manifest(str(path))[0]
+    assert job.layers == ({"max_iter": 300, "allow": ("units",), "tol": 1e-4},
+                          {"allow": ("needles",), "tol": 1e-5})
+    assert job.over({"allow": ("rigid-part",), "strict": None}).settings == {
+        "max_iter": 300, "allow": ("units", "needles", "rigid-part"), "tol": 1e-5}
+    batch = BatchJob(str(path), str(tmp_path / "out"), settings={"strict": True})
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        batch.workers = 2  # type: ignore[misc]
+    done = run_batch(batch)
+    assert (done.exit_code, done.stopped, done.failure) == (0, None, None)
+    assert [(r.job, r.status.value) for r in done.rows] == [("twist", "ok")]
+    assert done.rows[0].seen.mesh is None  # shipped: what the run saw stays in its process
+    assert (tmp_path / "out" / "summary.csv").exists()
+    assert run_batch(batch).rows[0].status.value == "up-to-date"
+
+
+def test_a_report_that_cannot_be_written_comes_after_the_summary(tmp_path, monkeypatch):
+    """A report path refused before any job runs; one whose write fails after the jobs
+    (a full disk: here a write that raises) is the outcome's failure, the summary written
+    first."""
+    from srarap_cli.runtime.errors import OutputError
+    from srarap_cli.tasks.batch import BatchJob, run_batch
+    from srarap_cli.tasks.batch import run as batch_run
+
+    path = manifest(tmp_path, [{"name": "twist", "mesh": BAR, "handles": TWIST,
+                                "output": "twist.obj"}])
+    (tmp_path / "blocker").write_text("a file where the report's folder would be")
+    with pytest.raises(OutputError, match="blocker is a file"):
+        run_batch(BatchJob(str(path), str(tmp_path / "out"),
+                           junit=str(tmp_path / "blocker" / "junit.xml")))
+    assert not (tmp_path / "out").exists()
+
+    def full_disk(*args, **kwargs):
+        raise OutputError("junit.xml: No space left on device")
+    monkeypatch.setattr(batch_run, "write_reports", full_disk)
+    done = run_batch(BatchJob(str(path), str(tmp_path / "out"),
+                              junit=str(tmp_path / "junit.xml")))
+    assert done.failure is not None and "No space" in str(done.failure)
+    assert [r.status.value for r in done.rows] == ["ok"]
+    assert (tmp_path / "out" / "summary.json").exists()

@@ -11,13 +11,12 @@ from helpers import ROOT, ends, run_cli, tube, tube_handles, twist
 from srarap_cli.io.mesh import Mesh, write_mesh
 from srarap_cli.runtime import parallel
 from srarap_cli.runtime.errors import InputError
-from srarap_cli.runtime.parallel import at_most, map_blocks, row_blocks, using_threads
+from srarap_cli.runtime.parallel import at_most, map_blocks, row_blocks, using_threads, worker_share
 from srarap_cli.solver import linalg, one_triangle, operators
 from srarap_cli.solver.multires.simplify import simplify_to_subset
 from srarap_cli.solver.oneshot import make_deformer
 from srarap_cli.solver.operators import cell_graph
 from srarap_cli.solver.settings import resolve
-from srarap_cli.tasks.batch.run import job_threads
 from srarap_cli.tasks.fingerprint import fingerprint
 
 
@@ -144,13 +143,13 @@ def test_a_ceiling_caps_what_a_solve_asks_for():
 
 def test_a_batch_divides_the_cpus_among_its_workers(monkeypatch):
     monkeypatch.delenv(parallel.ENV, raising=False)
-    monkeypatch.setattr("srarap_cli.tasks.batch.run.available_cpus", lambda: 16)
-    assert job_threads(1) == 16 and job_threads(4) == 4 and job_threads(32) == 1
-    assert job_threads(4, asked=8) == 4 and job_threads(4, asked=2) == 2
+    monkeypatch.setattr("srarap_cli.runtime.parallel.available_cpus", lambda: 16)
+    assert worker_share(1) == 16 and worker_share(4) == 4 and worker_share(32) == 1
+    assert worker_share(4, asked=8) == 4 and worker_share(4, asked=2) == 2
     monkeypatch.setenv(parallel.ENV, "3")
-    assert job_threads(2) == 3 and job_threads(8) == 2
-    monkeypatch.setattr("srarap_cli.tasks.batch.run.available_cpus", lambda: 1)
-    assert job_threads(2, asked=4) == 1
+    assert worker_share(2) == 3 and worker_share(8) == 2
+    monkeypatch.setattr("srarap_cli.runtime.parallel.available_cpus", lambda: 1)
+    assert worker_share(2, asked=4) == 1
 
 
 def test_the_thread_count_is_not_part_of_a_jobs_fingerprint(tmp_path):

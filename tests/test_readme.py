@@ -152,8 +152,8 @@ def test_the_guides_manifest_example_is_a_valid_manifest(tmp_path):
     path = tmp_path / "regression.yaml"
     path.write_text(block)
     jobs = load_manifest(str(path))
-    assert [j["name"] for j in jobs] == ["bar-twist"] and os.path.exists(jobs[0]["mesh"])
-    assert jobs[0]["expect"].energy_rtol == 1e-4 and jobs[0]["expect"].iterations_within == 3
+    assert [j.name for j in jobs] == ["bar-twist"] and os.path.exists(jobs[0].mesh)
+    assert jobs[0].expect.energy_rtol == 1e-4 and jobs[0].expect.iterations_within == 3
     steps = [run_cli(["batch", path, "-o", tmp_path / "out", *extra], cwd=tmp_path).returncode
              for extra in ([], ["--update-goldens"], [])]
     assert steps == [8, 8, 0] and (tmp_path / "golden" / "bar-twist.obj").exists()

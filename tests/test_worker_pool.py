@@ -44,7 +44,7 @@ import os, signal
 from srarap_cli.tasks.batch import run as batch
 real = batch.run_job
 def run_job(job, *args, **kwargs):
-    if job["name"] == "huge":
+    if job.name == "huge":
         os.kill(os.getpid(), signal.SIGKILL)
     return real(job, *args, **kwargs)
 batch.run_job = run_job

@@ -6,22 +6,10 @@ import shlex
 import click
 
 from ..runtime import exit_codes
-from ..runtime.errors import OutputError
-from ..runtime.paths import hold
-from ..runtime.signals import Terminated, block
-from ..solver.settings import BY_NAME, overlay
-from ..tasks.batch import (
-    SUMMARIES,
-    BatchInterrupted,
-    check_goldens,
-    check_outputs,
-    load_manifest,
-    run_batch,
-    write_reports,
-    write_summaries,
-)
-from ..tasks.job_status import JobStatus, batch_exit_code
-from ..tasks.preflight import check_output_path
+from ..runtime.signals import Terminated
+from ..solver.settings import BY_NAME
+from ..tasks.batch import BatchJob, run_batch
+from ..tasks.job_status import JobStatus
 from .common import guarded, printable, say
 from .options import StrictCommand, ThreadCount, setting_option
 from .progress import job_heartbeat
@@ -78,50 +66,22 @@ def batch(manifest: str, workers: int, scheduler: str | None, out: str, keep_unc
     if scheduler is not None and scheduler != "local" and not SCHEDULER.fullmatch(scheduler):
         raise click.BadParameter(f"{scheduler!r} is neither 'local' nor a scheduler address "
                                  "such as tcp://host:8786", param_hint="--scheduler")
-    if report is not None:
-        check_output_path(report, (".html", ".htm"), "--report")
-    if junit is not None:
-        check_output_path(junit, (".xml",), "--junit")
-    for path, what in ((markdown, "--summary-md"), (metrics, "--metrics")):
-        if path is not None:
-            check_output_path(path, None, what)
     goldens = "accept" if accept_goldens else "update" if update_goldens else "check"
-    jobs = load_manifest(manifest)
-    for job in jobs:  # over the manifest's defaults and each job's settings, as in deform
-        job["settings"] = overlay(job["settings"], {"strict": strict or None,
-                                                    "allow": allow or None})
-        job["goldens"] = goldens
-    if goldens != "check":
-        check_goldens(jobs, manifest)
-    check_outputs(jobs, out, manifest)
-    try:
-        os.makedirs(out, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"{out}: cannot create folder: {exc.strerror}") from None
-    for name in SUMMARIES:  # before solving, as deform checks its -o
-        check_output_path(os.path.join(out, name), None, "summary")
-    held = hold(out)  # every file of the run is written there, whatever -o names later
-    try:
-        rows, stopped = run_batch(jobs, held, workers, scheduler, keep_unconverged,
-                                  pictures=report is not None, threads=threads,
-                                  heartbeat=None if quiet else job_heartbeat), None
-    except BatchInterrupted as exc:  # the workers are stopped: say what finished
-        rows, stopped = exc.rows, exc.signal
-        # the summary is what is left to do: a second Ctrl-C or SIGTERM (a CI runner's
-        # timeout sends more than one) must not cost it; the exit code says stopped anyway
-        block()
-    # the summary first, on its own: a report that cannot be written (a full disk) must not
-    # cost the account of the jobs whose outputs are on disk
-    write_summaries(rows, held)
-    _tell(rows, out, quiet, stopped)
-    _tell_goldens(rows, manifest, out, goldens)
-    write_reports(rows, manifest, report, junit, markdown, metrics)
-    if stopped is not None:
-        raise SystemExit(exit_codes.TERMINATED if isinstance(stopped, Terminated)
+    done = run_batch(BatchJob(
+        manifest, out, workers=workers, scheduler=scheduler, keep_unconverged=keep_unconverged,
+        goldens=goldens, threads=threads, settings={"strict": strict or None,
+                                                    "allow": allow or None},
+        report=report, junit=junit, markdown=markdown, metrics=metrics,
+        heartbeat=None if quiet else job_heartbeat))
+    _tell(done.rows, out, quiet, done.stopped)
+    _tell_goldens(done.rows, manifest, out, goldens)
+    if done.failure is not None:
+        raise done.failure
+    if done.stopped is not None:
+        raise SystemExit(exit_codes.TERMINATED if isinstance(done.stopped, Terminated)
                          else exit_codes.INTERRUPTED)
-    code = batch_exit_code(r.status for r in rows)
-    if code:
-        raise SystemExit(code)
+    if done.exit_code:
+        raise SystemExit(done.exit_code)
 
 
 def _tell(rows, out, quiet, stopped):

@@ -177,6 +177,22 @@ def thread_count(value: object) -> int | None:
     return value
 
 
+def worker_share(workers: int, asked: int | None = None) -> int:
+    """Threads for each of ``workers`` side by side (a batch's worker processes): its share
+    of the CPUs this process may use (at least 1), or less where ``asked`` (``--threads``)
+    or ``$SRARAP_THREADS`` says so.
+
+    Examples
+    --------
+    >>> worker_share(10 ** 6)
+    1
+    """
+    share = max(1, available_cpus() // max(1, workers))
+    if asked is None and os.environ.get(ENV, "").strip():
+        asked = default_threads()
+    return share if asked is None else max(1, min(asked, share))
+
+
 def cap_note(asked: int | None) -> list[str]:
     """The ``-v`` line that says a thread count (``asked``: ``--threads`` or the setting;
     None: ``$SRARAP_THREADS`` or the CPUs) was capped at the CPUs this process may use, or

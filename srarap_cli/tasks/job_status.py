@@ -3,9 +3,14 @@ batch's console table, ``summary.csv`` / ``summary.json``, the HTML report, JUni
 import enum
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..runtime import exit_codes
+
+if TYPE_CHECKING:
+    from ..io.handles import Constraints
+    from ..io.mesh import Mesh
+    from .comparison import Comparison, Expect
 
 #: the columns of a batch's ``summary.csv`` (``summary.json`` holds ``warnings`` as a list;
 #: ``stop``: the solve's :class:`~srarap_cli.solver.stop.StopReason`, empty for a job that
@@ -74,6 +79,28 @@ _EXIT_CODES = {JobStatus.OK: exit_codes.OK, JobStatus.UP_TO_DATE: exit_codes.OK,
 
 
 @dataclass
+class Seen:
+    """What a job's run saw, kept in the process that ran it for the report's pictures
+    (:func:`srarap_cli.tasks.batch.run.job_pictures`); never sent between processes.
+
+    Attributes
+    ----------
+    mesh : Mesh, the rest mesh read; deformed : Mesh, the mesh written (or solved, unwritten)
+    constraints : Constraints, the handles resolved on the mesh
+    log : list of dict, the solve's per-iteration log rows
+    golden : (Comparison, Expect), the distances to the golden and its gates
+    recorded_seconds : float, the seconds an up-to-date job's recorded run took
+    """
+
+    mesh: "Mesh | None" = None
+    deformed: "Mesh | None" = None
+    constraints: "Constraints | None" = None
+    log: list[dict[str, Any]] | None = None
+    golden: "tuple[Comparison, Expect] | None" = None
+    recorded_seconds: float | None = None
+
+
+@dataclass
 class JobResult:
     """One job's result.
 
@@ -98,7 +125,7 @@ class JobResult:
     peaks : dict stage -> bytes, peak memory per stage (``-v``)
     solve : DeformResult, settings : Settings, the solve and its settings (in the process
         that ran it; not sent between processes)
-    seen : dict, what the report's pictures are drawn from
+    seen : Seen, what the report's pictures are drawn from
     pictures : dict name -> base64 PNG, the report's pictures of the job
     """
 
@@ -126,7 +153,7 @@ class JobResult:
     peaks: dict[str, int | None] = field(default_factory=dict, repr=False)
     solve: Any = field(default=None, repr=False)
     settings: Any = field(default=None, repr=False)
-    seen: dict[str, Any] = field(default_factory=dict, repr=False)
+    seen: Seen = field(default_factory=Seen, repr=False)
     pictures: dict[str, str] = field(default_factory=dict, repr=False)
 
     def row(self) -> dict[str, Any]:
@@ -144,5 +171,5 @@ class JobResult:
         """This result without what stays in the process that ran it (the solve's arrays),
         as a worker sends it back."""
         self.solve = self.settings = None
-        self.seen = {}
+        self.seen = Seen()
         return self

@@ -7,9 +7,9 @@ from ...io.handles import referenced_files
 from ...io.mesh.formats import extensions, suffix_of
 from ...runtime.errors import InputError, excerpt, unknown_key
 from ...runtime.paths import leads_out, refuse_overwriting_inputs
-from ...solver.settings import overlay, parse_mapping
+from ...solver.settings import parse_mapping
 from ..comparison import parse_expect, record_path, refuse_leading_out
-from .rows import Job
+from .manifest_job import ManifestJob
 
 TOP_KEYS = ("jobs", "defaults")
 JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
@@ -17,9 +17,9 @@ JOB_KEYS = ("name", "mesh", "handles", "output", "settings", "expect")
 SUMMARIES = ("summary.csv", "summary.json")
 
 
-def load_manifest(path: str) -> list[Job]:
-    """Jobs of a manifest, with absolute paths, merged settings and their gates (list of dict;
-    ``golden_root``: the manifest's folder, the only place its goldens may be written)."""
+def load_manifest(path: str) -> list[ManifestJob]:
+    """Jobs of a manifest, with absolute paths, their settings' layers (the manifest's
+    ``defaults`` under the job's ``settings``) and their gates."""
     doc = load_document(path, "json" if path.lower().endswith(".json") else "yaml")
     if isinstance(doc, dict):
         _known(f"{path}", doc, TOP_KEYS, "the manifest")
@@ -27,7 +27,7 @@ def load_manifest(path: str) -> list[Job]:
         raise InputError(f"{path}: a manifest needs a non-empty 'jobs' list")
     base = os.path.dirname(os.path.abspath(path))
     defaults = _settings(path, "defaults", doc.get("defaults", {}))
-    jobs: list[Job] = []
+    jobs: list[ManifestJob] = []
     names: set[str] = set()
     outputs: set[str] = set()
     for k, job in enumerate(doc["jobs"]):
@@ -48,11 +48,10 @@ def load_manifest(path: str) -> list[Job]:
         expect = job.get("expect")
         if expect is not None:
             expect = _expect(where, base, expect)
-        jobs.append({"name": name, "mesh": os.path.join(base, str(job["mesh"])),
-                     "handles": os.path.join(base, str(job["handles"])),
-                     "output": output, "expect": expect, "golden_root": base,
-                     "settings": overlay(defaults, _settings(where, "settings",
-                                                             job.get("settings", {})))})
+        own = _settings(where, "settings", job.get("settings", {}))
+        jobs.append(ManifestJob(name, os.path.join(base, str(job["mesh"])),
+                                os.path.join(base, str(job["handles"])), output, expect,
+                                golden_root=base, layers=(defaults, own)))
     return jobs
 
 
@@ -96,46 +95,50 @@ def _refuse_nesting(where, output, outputs):
                              "would be a folder holding the other")
 
 
-def check_outputs(jobs: list[Job],
+def check_outputs(jobs: list[ManifestJob],
                   out_dir: str, manifest: str) -> None:
     """Refuse a run whose outputs (or their sidecars) would land on any job's input or the
     manifest: a batch must never overwrite what it reads."""
     inputs = [("manifest", manifest)]
     for job in jobs:
-        inputs += [(f"mesh of job {job['name']!r}", job["mesh"]),
-                   (f"handle file of job {job['name']!r}", job["handles"]),
-                   *((f"file named by job {job['name']!r}'s handles", path)
-                     for path in referenced_files(job["handles"])),
-                   *([(f"golden mesh of job {job['name']!r}", job["expect"].golden)]
-                     if job["expect"] else [])]
+        inputs += _inputs(job)
+        if job.expect:
+            inputs.append((f"golden mesh of job {job.name!r}", job.expect.golden))
     _stay_inside(jobs, out_dir)
     outputs = [os.path.join(out_dir, name) for job in jobs
-               for name in (job["output"], job["output"] + ".srarap.json")]
+               for name in (job.output, job.output + ".srarap.json")]
     outputs += [os.path.join(out_dir, name) for name in SUMMARIES]
     refuse_overwriting_inputs(outputs, inputs)
 
 
-def check_goldens(jobs: list[Job], manifest: str) -> None:
+def check_goldens(jobs: list[ManifestJob], manifest: str) -> None:
     """Before ``--update-goldens`` runs anything: refuse a golden (or its record) that would
     be written outside its manifest's folder (symbolic links followed), onto any input of the
     run, or that two jobs would both write."""
     inputs = [("manifest", manifest)]
     for job in jobs:
-        inputs += [(f"mesh of job {job['name']!r}", job["mesh"]),
-                   (f"handle file of job {job['name']!r}", job["handles"]),
-                   *((f"file named by job {job['name']!r}'s handles", path)
-                     for path in referenced_files(job["handles"]))]
+        inputs += _inputs(job)
     owners: dict[str, str] = {}
     for job in jobs:
-        if not job["expect"]:
+        if not job.expect:
             continue
-        golden = job["expect"].golden
-        refuse_leading_out(golden, job["golden_root"], f"job {job['name']!r}: golden ")
-        other = owners.setdefault(os.path.realpath(golden), job["name"])
-        if other != job["name"]:
-            raise InputError(f"job {job['name']!r}: golden {golden} is also job {other!r}'s: "
+        golden = job.expect.golden
+        root = job.golden_root or os.path.dirname(os.path.abspath(manifest))
+        refuse_leading_out(golden, root, f"job {job.name!r}: golden ")
+        other = owners.setdefault(os.path.realpath(golden), job.name)
+        if other != job.name:
+            raise InputError(f"job {job.name!r}: golden {golden} is also job {other!r}'s: "
                              "--update-goldens would write it twice")
         refuse_overwriting_inputs([golden, record_path(golden)], inputs)
+
+
+def _inputs(job):
+    """What ``job`` reads, each with its words: its mesh, its handle file and the files that
+    names."""
+    return [(f"mesh of job {job.name!r}", job.mesh),
+            (f"handle file of job {job.name!r}", job.handles),
+            *((f"file named by job {job.name!r}'s handles", path)
+              for path in referenced_files(job.handles))]
 
 
 def _stay_inside(jobs, out_dir):
@@ -143,10 +146,10 @@ def _stay_inside(jobs, out_dir):
     inside ``out_dir`` would carry outside it (the names were checked as text when the
     manifest was read; the writes check again when they happen)."""
     for job in jobs:
-        for name in (job["output"], job["output"] + ".srarap.json"):
+        for name in (job.output, job.output + ".srarap.json"):
             target = leads_out(os.path.join(out_dir, name), out_dir)
             if target is not None:
-                raise InputError(f"job {job['name']!r}: {name!r} leads out of the output "
+                raise InputError(f"job {job.name!r}: {name!r} leads out of the output "
                                  f"folder {out_dir} (through a symbolic link, to {target})")
     for name in SUMMARIES:
         target = leads_out(os.path.join(out_dir, name), out_dir)

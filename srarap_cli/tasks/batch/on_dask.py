@@ -11,7 +11,8 @@ from ...runtime.paths import hold
 from ...runtime.signals import Terminated, block
 from ...runtime.threads import worker_processes
 from ..job_status import JobResult
-from .rows import BatchInterrupted, Job, interrupted_row, unfinished_row
+from .manifest_job import ManifestJob
+from .rows import BatchInterrupted, interrupted_row, unfinished_row
 from .worker_pool import WORKER_START
 
 #: what srarap's own Dask workers get instead of Dask's defaults: one BLAS thread, and glibc's
@@ -42,8 +43,8 @@ LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ": WORKER_ENVIRON,
                 "distributed.scheduler.allowed-failures": 1}
 
 
-def run_on_dask(jobs: list[Job], run: "functools.partial[JobResult]", scheduler: str,
-                workers: int, unfinished: Callable[[Job], JobResult] = interrupted_row
+def run_on_dask(jobs: list[ManifestJob], run: "functools.partial[JobResult]", scheduler: str,
+                workers: int, unfinished: Callable[[ManifestJob], JobResult] = interrupted_row
                 ) -> list[JobResult]:
     """The results of ``jobs`` run by ``run`` (:func:`.batch.run_job` with its keywords
     bound, ``out_dir`` among them) on the cluster at ``scheduler``, or on a local one of
@@ -107,7 +108,8 @@ class _Stopped(BaseException):
         super().__init__("stopped")
         self.finished, self.signal = finished, signal
 
-    def rows(self, jobs: list[Job], unfinished: Callable[[Job], JobResult]) -> BatchInterrupted:
+    def rows(self, jobs: list[ManifestJob],
+             unfinished: Callable[[ManifestJob], JobResult]) -> BatchInterrupted:
         return BatchInterrupted([row if row is not None else unfinished(job)
                                  for row, job in zip(self.finished, jobs)], self.signal)
 

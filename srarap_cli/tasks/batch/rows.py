@@ -1,17 +1,12 @@
 """A batch's results of jobs that did not finish (a signal stopped the batch, a worker process
 died), and the interruption that carries every job's result."""
 import os
-from typing import Any
 
 from ...runtime import exit_codes
 from ...runtime.signals import Terminated
 from ..deform import DeformJob, JobResult, JobStatus, recorded_result, sidecar_path
+from .manifest_job import ManifestJob
 from .worker_pool import death_note
-
-#: a job of a manifest: name, absolute paths, output, settings, expect (an Expect, or a
-#: mapping of its keys), golden_root, and what to do with goldens (``goldens``: see
-#: :data:`..deform.golden.GOLDEN_MODES`)
-Job = dict[str, Any]
 
 
 class BatchInterrupted(BaseException):
@@ -28,17 +23,16 @@ class BatchInterrupted(BaseException):
                 row.exit_code = code
 
 
-def deform_job(job: Job, out_dir: str, keep_unconverged: bool = False) -> DeformJob:
+def deform_job(job: ManifestJob, out_dir: str, keep_unconverged: bool = False) -> DeformJob:
     """The :class:`~.job.DeformJob` of a manifest's job (see :mod:`.manifest`), writing
     under ``out_dir`` and keeping its record there."""
-    return DeformJob(job["mesh"], job["handles"], os.path.join(out_dir, job["output"]),
-                     settings=job["settings"], name=job["name"],
-                     keep_unconverged=keep_unconverged, expect=job["expect"], record=True,
-                     inside=out_dir, goldens=job.get("goldens", "check"),
-                     golden_root=job.get("golden_root"))
+    return DeformJob(job.mesh, job.handles, os.path.join(out_dir, job.output),
+                     settings=job.settings, name=job.name,
+                     keep_unconverged=keep_unconverged, expect=job.expect, record=True,
+                     inside=out_dir, goldens=job.goldens, golden_root=job.golden_root)
 
 
-def interrupted_row(job: Job, out_dir: str | None = None, keep_unconverged: bool = False,
+def interrupted_row(job: ManifestJob, out_dir: str | None = None, keep_unconverged: bool = False,
                     since: float | None = None) -> JobResult:
     """The result of a job a signal stopped before its result came back. Where its record
     under ``out_dir`` matches its inputs, the files on disk are that run's: the job is
@@ -52,11 +46,11 @@ def interrupted_row(job: Job, out_dir: str | None = None, keep_unconverged: bool
             if done.status is JobStatus.UP_TO_DATE:
                 done.status = JobStatus.OK
         return done
-    return JobResult(job["name"], JobStatus.INTERRUPTED, JobStatus.INTERRUPTED.exit_code,
+    return JobResult(job.name, JobStatus.INTERRUPTED, JobStatus.INTERRUPTED.exit_code,
                      message="not finished: the batch was interrupted")
 
 
-def solved_since(row: JobResult, job: Job, out_dir: str, since: float) -> JobResult:
+def solved_since(row: JobResult, job: ManifestJob, out_dir: str, since: float) -> JobResult:
     """``row``, an ``up-to-date`` job's, as ``ok`` where its record was written after
     ``since`` (the batch's start): this batch solved it, and a second run of it found its
     own outputs (a Dask worker that a signal or a crash stopped after the commit, its task
@@ -74,12 +68,12 @@ def _recorded_since(spec: DeformJob, since: float) -> bool:
         return False
 
 
-def lost_row(job: Job, exitcode: int) -> JobResult:
+def lost_row(job: ManifestJob, exitcode: int) -> JobResult:
     """The result of a job whose worker process died when it ran alone."""
     return unfinished_row(job, death_note(exitcode),
                           128 - exitcode if exitcode < 0 else exitcode or 1)
 
 
-def unfinished_row(job: Job, reason: str, exit_code: int) -> JobResult:
+def unfinished_row(job: ManifestJob, reason: str, exit_code: int) -> JobResult:
     """The result of a job that failed without a result of its own (its process died)."""
-    return JobResult(job["name"], JobStatus.FAILED, exit_code, message=f"not finished: {reason}")
+    return JobResult(job.name, JobStatus.FAILED, exit_code, message=f"not finished: {reason}")

@@ -17,28 +17,148 @@ the same fingerprint (content of the mesh, the handle file and every file it nam
 srarap version).
 """
 import contextlib
+import dataclasses
 import functools
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
+from dataclasses import dataclass, field
 from typing import Any
 
 from ...io.handles import load_handles
 from ...io.mesh import read_mesh
-from ...runtime.parallel import ENV, at_most, available_cpus, default_threads, using_threads
-from ...runtime.signals import Terminated
+from ...runtime.errors import OutputError
+from ...runtime.parallel import at_most, using_threads, worker_share
+from ...runtime.paths import hold
+from ...runtime.signals import Terminated, block
 from ..deform import JobResult, run_job_safely
+from ..job_status import Seen, batch_exit_code
 from ..pictures import difference_picture, energy_picture, shape_picture
+from ..preflight import check_output_path
 from ..reports import encode_png
+from .manifest import SUMMARIES, check_goldens, check_outputs, load_manifest
+from .manifest_job import ManifestJob
 from .on_dask import run_on_dask
-from .rows import BatchInterrupted, Job, deform_job, interrupted_row, lost_row, solved_since
+from .rows import BatchInterrupted, deform_job, interrupted_row, lost_row, solved_since
+from .summary import write_reports, write_summaries
 from .worker_pool import PoolStopped, run_in_processes
 
+Heartbeat = Callable[[str], AbstractContextManager[Any]]
 
-def run_job(job: Job, out_dir: str, keep_unconverged: bool = False,
+
+@dataclass(frozen=True)
+class BatchJob:
+    """One run of a manifest, as ``srarap batch`` takes it.
+
+    Attributes
+    ----------
+    manifest : str, the manifest's path (YAML or JSON)
+    out : str, the folder of the jobs' outputs and of ``summary.csv`` / ``summary.json``
+    workers : int, worker processes (1: the jobs run in this process)
+    scheduler : str, optional, ``local`` or a Dask scheduler's address
+    keep_unconverged : bool, write the mesh of a job that did not converge
+    goldens : str, ``check``, ``update`` or ``accept`` (:data:`..deform.golden.GOLDEN_MODES`)
+    threads : int, optional, each job's threads, at most its share of the CPUs
+    settings : mapping, setting values laid over every job's (the command line's
+        ``strict`` and ``allow``)
+    report, junit, markdown, metrics : str, optional, the reports to write too
+    heartbeat : callable(name) -> context, optional, what says a long job's stages (a
+        picklable function: the workers call it)
+    """
+
+    manifest: str
+    out: str = "."
+    workers: int = 1
+    scheduler: str | None = None
+    keep_unconverged: bool = False
+    goldens: str = "check"
+    threads: int | None = None
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    report: str | None = None
+    junit: str | None = None
+    markdown: str | None = None
+    metrics: str | None = None
+    heartbeat: Heartbeat | None = None
+
+
+@dataclass
+class BatchOutcome:
+    """What a batch did: ``rows`` (the jobs' results, in manifest order), ``out`` (the
+    output folder as held), ``stopped`` (the signal's exception that stopped it, else None)
+    and ``failure`` (an error that came after the summary was written: a report that could
+    not be written; the caller raises it once it has said the rows)."""
+
+    rows: list[JobResult]
+    out: str
+    stopped: BaseException | None = None
+    failure: Exception | None = None
+
+    @property
+    def exit_code(self) -> int:
+        """The exit code of a batch that ran to its end (see :func:`batch_exit_code`)."""
+        return batch_exit_code(r.status for r in self.rows)
+
+
+def run_batch(batch: BatchJob) -> BatchOutcome:
+    """Run ``batch``: its checks before any job (the reports' paths, the goldens it may
+    write, outputs that would land on inputs), the jobs (a failing job never stops the
+    others), then ``summary.csv`` / ``summary.json`` and the reports asked for.
+
+    A signal stops the jobs; the outcome says which (``stopped``) and holds the rows of the
+    jobs that finished, the summary written all the same.
+
+    Raises InputError, UsageProblem or OutputError for a run that cannot start.
+    """
+    _check_reports(batch)
+    # over the manifest's defaults and each job's settings, as deform's over a handle file's
+    jobs = [dataclasses.replace(job.over(batch.settings), goldens=batch.goldens)
+            for job in load_manifest(batch.manifest)]
+    if batch.goldens != "check":
+        check_goldens(jobs, batch.manifest)
+    check_outputs(jobs, batch.out, batch.manifest)
+    try:
+        os.makedirs(batch.out, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"{batch.out}: cannot create folder: {exc.strerror}") from None
+    for name in SUMMARIES:  # before solving, as deform checks its -o
+        check_output_path(os.path.join(batch.out, name), None, "summary")
+    held = hold(batch.out)  # every file of the run is written there, whatever -o names later
+    outcome = BatchOutcome([], held)
+    try:
+        outcome.rows = run_jobs(jobs, held, batch.workers, batch.scheduler,
+                                batch.keep_unconverged, pictures=batch.report is not None,
+                                threads=batch.threads, heartbeat=batch.heartbeat)
+    except BatchInterrupted as exc:  # the workers are stopped: say what finished
+        outcome.rows, outcome.stopped = exc.rows, exc.signal
+        # the summary is what is left to do: a second Ctrl-C or SIGTERM (a CI runner's
+        # timeout sends more than one) must not cost it; the exit code says stopped anyway
+        block()
+    # the summary first, on its own: a report that cannot be written (a full disk) must not
+    # cost the account of the jobs whose outputs are on disk
+    write_summaries(outcome.rows, held)
+    try:
+        write_reports(outcome.rows, batch.manifest, batch.report, batch.junit, batch.markdown,
+                      batch.metrics)
+    except OutputError as exc:
+        outcome.failure = exc
+    return outcome
+
+
+def _check_reports(batch):
+    """Refuse, before any job, a report that could not be written."""
+    if batch.report is not None:
+        check_output_path(batch.report, (".html", ".htm"), "--report")
+    if batch.junit is not None:
+        check_output_path(batch.junit, (".xml",), "--junit")
+    for path, what in ((batch.markdown, "--summary-md"), (batch.metrics, "--metrics")):
+        if path is not None:
+            check_output_path(path, None, what)
+
+
+def run_job(job: ManifestJob, out_dir: str, keep_unconverged: bool = False,
             pictures: bool = False, threads: int | None = None,
-            heartbeat: Callable[[str], AbstractContextManager[Any]] | None = None) -> JobResult:
+            heartbeat: Heartbeat | None = None) -> JobResult:
     """Run one job of a manifest through the job runner (:func:`.job.run_job_safely`);
     never raises. With ``pictures``, the result carries the report's pictures of the job
     (see :func:`job_pictures`).
@@ -49,60 +169,59 @@ def run_job(job: Job, out_dir: str, keep_unconverged: bool = False,
     ``threads`` setting, where smaller, stands). ``heartbeat(name)``: a context that says the
     job's stages while it runs long (a picklable function: workers call it)."""
     spec = deform_job(job, out_dir, keep_unconverged)
-    beat = heartbeat(job["name"]) if heartbeat is not None else contextlib.nullcontext()
-    with beat, at_most(threads or available_cpus()), using_threads(threads):
+    beat = heartbeat(job.name) if heartbeat is not None else contextlib.nullcontext()
+    with beat, at_most(worker_share(1, threads)), using_threads(threads):
         result = run_job_safely(spec)
     if pictures:  # after the seconds: the solve's, not the drawing's
         result.pictures = job_pictures(job, spec.output, result.seen)
     return result.shipped()
 
 
-def job_pictures(job: Job, out: str, seen: dict[str, Any]) -> dict[str, str]:
+def job_pictures(job: ManifestJob, out: str, seen: Seen) -> dict[str, str]:
     """The report's pictures of a job (base64 PNG by name: ``shape``, ``difference``,
     ``energy``), drawn from what the job solved or, for one up to date, from its files;
     those without their data are left out (a failed job's, a missing golden's); a drawing
     that fails leaves ``note`` instead, which the report shows."""
     out_pictures: dict[str, str] = {}
     try:
-        mesh = seen["mesh"] if "mesh" in seen else read_mesh(job["mesh"])
-        deformed = seen.get("deformed")
+        mesh = seen.mesh if seen.mesh is not None else read_mesh(job.mesh)
+        deformed = seen.deformed
         if deformed is None and os.path.exists(out):
             deformed = read_mesh(out)
         if deformed is None or len(deformed.vertices) != len(mesh.vertices):
             return out_pictures
-        constraints = (seen["constraints"] if "constraints" in seen
-                       else load_handles(job["handles"], mesh.vertices, any_rate=True))
+        constraints = (seen.constraints if seen.constraints is not None
+                       else load_handles(job.handles, mesh.vertices, any_rate=True))
         out_pictures["shape"] = encode_png(shape_picture(mesh, deformed, constraints))
-        golden = seen.get("golden")
-        if golden is not None:
-            found, expect = golden
+        if seen.golden is not None:
+            found, expect = seen.golden
             out_pictures["difference"] = encode_png(difference_picture(
                 mesh, deformed, found.of_b(len(deformed.vertices)), expect.tol,
                 found.scale))
-        if seen.get("log"):
-            out_pictures["energy"] = encode_png(energy_picture(seen["log"]))
+        if seen.log:
+            out_pictures["energy"] = encode_png(energy_picture(seen.log))
     except Exception as exc:  # noqa: BLE001 -- the report says why, the job's result stands
         out_pictures["note"] = f"pictures not drawn: {type(exc).__name__}: {exc}"
     return out_pictures
 
 
-def run_batch(jobs: list[Job],
-              out_dir: str, workers: int = 1, scheduler: str | None = None, keep_unconverged: bool = False,
-              pictures: bool = False, threads: int | None = None,
-              heartbeat: Callable[[str], AbstractContextManager[Any]] | None = None
-              ) -> list[JobResult]:
+def run_jobs(jobs: list[ManifestJob], out_dir: str, workers: int = 1,
+             scheduler: str | None = None, keep_unconverged: bool = False,
+             pictures: bool = False, threads: int | None = None,
+             heartbeat: Heartbeat | None = None) -> list[JobResult]:
     """Run jobs: on a Dask cluster at ``scheduler``, else in ``workers`` local processes
     (in this process when 1). Rows come back in manifest order. ``keep_unconverged``: see
     :func:`run_job`. Each job's solve runs ``threads`` threads (default
     ``$SRARAP_THREADS``, else its share of the CPUs), never more than its share, so that
-    workers times threads stays within the CPUs (:func:`job_threads`).
+    workers times threads stays within the CPUs
+    (:func:`~srarap_cli.runtime.parallel.worker_share`).
 
     The Dask workers must see the same files as this process (a shared file system).
     ``heartbeat``: see :func:`run_job`.
     """
     since = time.time()
     run = functools.partial(run_job, out_dir=out_dir, keep_unconverged=keep_unconverged,
-                            pictures=pictures, threads=job_threads(workers, threads),
+                            pictures=pictures, threads=worker_share(workers, threads),
                             heartbeat=heartbeat)
     unfinished = functools.partial(interrupted_row, out_dir=out_dir,
                                    keep_unconverged=keep_unconverged, since=since)
@@ -127,22 +246,6 @@ def _rows(jobs, run, workers, scheduler, unfinished):
                                    exc) from None
         return rows
     return _run_in_processes(jobs, run, workers, unfinished)
-
-
-def job_threads(workers: int, asked: int | None = None) -> int:
-    """Threads for each job of a batch of ``workers`` workers: its share of the CPUs this
-    process may use (at least 1), or less where ``asked`` (``--threads``) or
-    ``$SRARAP_THREADS`` says so.
-
-    Examples
-    --------
-    >>> job_threads(10 ** 6)
-    1
-    """
-    share = max(1, available_cpus() // max(1, workers))
-    asked = asked if asked is not None else (default_threads() if os.environ.get(ENV, "").strip()
-                                             else None)
-    return share if asked is None else max(1, min(asked, share))
 
 
 def _run_in_processes(jobs, run, workers, unfinished):

@@ -34,13 +34,13 @@ def check_golden(result: JobResult, expect: Expect | Mapping[str, Any], out: str
     (``compare_*`` and ``beyond_tol``, in the unit of ``tol``: a fraction of the golden
     mesh's diagonal with ``relative``; ``aligned``: the rigid motion applied first), status
     ``regressed`` with every failing gate in the message, or ``no-golden`` when the golden is
-    missing; the figures are kept in ``result.seen["golden"]`` for the report's difference
+    missing; the figures are kept in ``result.seen.golden`` for the report's difference
     picture. With ``goldens`` ``update`` or ``accept`` (see :data:`GOLDEN_MODES`) a missing
     or regressed golden is written from ``out`` (never outside ``root``) and
     ``result.golden`` says so; ``accept`` makes the job pass."""
     expect = as_expect(expect)
     run = Observed(result.iterations, result.energy,
-                   result.seconds if result.solved else result.seen.get("recorded_seconds"))
+                   result.seconds if result.solved else result.seen.recorded_seconds)
     result.tol = expect.tol
     if not os.path.exists(expect.golden):
         result.status, result.exit_code = JobStatus.NO_GOLDEN, JobStatus.NO_GOLDEN.exit_code
@@ -58,7 +58,7 @@ def _measure(result, expect, out, run):
                            expect.align).scaled(expect.relative)
     for name, value in found.row_figures(expect.tol).items():
         setattr(result, name, value)
-    result.seen["golden"] = (found, expect)
+    result.seen.golden = (found, expect)
     record = read_golden_record(expect.golden) if expect.needs_record else None
     unit = " (fractions of the golden mesh's diagonal)" if found.relative else ""
     failed = judge(found, expect, run, record, unit)

@@ -32,7 +32,7 @@ from ..comparison import Expect
 from ..distortion import vertex_distortion
 from ..fingerprint import fingerprint
 from ..info import up_axis
-from ..job_status import JobResult, JobStatus
+from ..job_status import JobResult, JobStatus, Seen
 from ..pictures import preview_png
 from ..pipeline import deform_mesh, refuse_warnings
 from ..preflight import check_output_path, load_posed, read_any_mesh, refuse_overwrite
@@ -205,7 +205,7 @@ def recorded_result(job: DeformJob, key: str | None = None) -> JobResult | None:
                        energy=rec["energy"], solved=False,
                        message="" if status is JobStatus.UP_TO_DATE
                        else "inputs unchanged since the recorded run",
-                       seen={"recorded_seconds": rec["seconds"]})
+                       seen=Seen(recorded_seconds=rec["seconds"]))
     return _judged(job, result)
 
 
@@ -277,8 +277,8 @@ def _solve(job, fmt, callback, write_stdout, key, on_warnings=None):
                      energy=solve.energy, solved=True,
                      message="" if keep else "mesh not written (--keep-unconverged writes it)",
                      written=job.output if keep else None, peaks=peaks, solve=solve,
-                     settings=opts, seen={"mesh": source, "deformed": deformed,
-                                          "constraints": constraints, "log": solve.log})
+                     settings=opts, seen=Seen(mesh=source, deformed=deformed,
+                                               constraints=constraints, log=solve.log))
 
 
 def _files(job, keep, mesh_bytes, deformed, source, constraints, solve):
