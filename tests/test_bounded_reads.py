@@ -106,12 +106,42 @@ def test_a_decompression_bomb_is_refused_before_the_disk_fills(tmp_path):
     assert done.stderr.startswith(f"srarap: error: {bomb}: decompresses to more than 64 MiB")
 
 
-def test_run_bounded_returns_raises_and_bounds():
+@pytest.mark.parametrize("threads", [1, 2])
+def test_run_bounded_returns_raises_and_bounds(monkeypatch, threads):
+    """Forked where this process runs one thread, a fresh interpreter where it does not
+    (issue 72: one fork policy, runtime.forking); both bound alike."""
+    import operator
+
+    from srarap_cli.runtime import bounded, forking
+    monkeypatch.setattr(forking, "threads", lambda: threads)
+    started = []
+    for way in ("_fork", "_fresh"):
+        real = getattr(bounded, way)
+        monkeypatch.setattr(bounded, way, lambda *a, real=real, way=way: (started.append(way),
+                                                                         real(*a))[1])
     assert run_bounded(np.arange, 5, seconds=10, memory=None).tolist() == [0, 1, 2, 3, 4]
+    assert started == ["_fork" if threads == 1 else "_fresh"]
     with pytest.raises(ZeroDivisionError):
-        run_bounded(lambda: 1 / 0, seconds=10, memory=None)
+        run_bounded(operator.truediv, 1, 0, seconds=10, memory=None)
     with pytest.raises(OutOfTime):
         run_bounded(time.sleep, 30, seconds=0.5, memory=None)
     with pytest.raises(OutOfMemory):
         run_bounded(np.ones, 10 ** 10, seconds=30, memory=200 << 20)
     assert time_bound(10 ** 6) > time_bound(0) > 0
+    assert len(set(started)) == 1
+
+
+def test_the_fork_policy_is_one_table(monkeypatch):
+    """Issue 72: every child srarap starts asks runtime.forking; a fork only where this
+    process runs a single thread."""
+    from srarap_cli.runtime import forking
+
+    table = {}
+    for threads in (1, 3):
+        monkeypatch.setattr(forking, "threads", lambda threads=threads: threads)
+        table[threads] = [forking.how(need) for need in forking.NEEDS]
+    assert dict(zip(forking.NEEDS, zip(table[1], table[3]))) == {
+        "bound": ("fork", "fresh"), "beside": ("fork", "here"), "gil": ("here", "fresh"),
+        "workers": ("fork", "fresh")}
+    with pytest.raises(ValueError):
+        forking.how("sometimes")

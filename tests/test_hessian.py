@@ -84,11 +84,11 @@ def test_rigid_motions_of_the_rest_shape_cost_nothing(state):
 
 def test_edge_blocks_give_the_same_products(state, monkeypatch):
     """Large meshes build and apply the Hessian a block of edges at a time."""
-    from srarap_cli.solver import operators
+    from srarap_cli.runtime import parallel
 
     d, P, R, rng = state
     whole = energy_hessian(d.graph, d.edges, P, R, d.bending_weight)
-    monkeypatch.setattr(operators, "EDGE_BLOCK", 47)
+    monkeypatch.setitem(parallel.PLANS, "edges", parallel.Plan(47, even=False))
     assert len(d.graph.edge_blocks()) > 5
     blocked = energy_hessian(d.graph, d.edges, P, R, d.bending_weight)
     u, w = rng.standard_normal((2, len(P), 3))

@@ -294,10 +294,11 @@ def test_output_bytes_do_not_depend_on_the_blas_thread_count(tmp_path):
 def test_the_library_solves_with_one_blas_thread():
     from threadpoolctl import threadpool_info
 
-    from srarap_cli.runtime.threads import single_threaded
-    seen = single_threaded(lambda: [i["num_threads"] for i in threadpool_info()
-                                    if i["user_api"] == "blas"])()
-    assert seen and set(seen) == {1}
+    from srarap_cli.runtime.parallel import available_cpus, current_threads, numerics
+    seen = numerics(lambda: ([i["num_threads"] for i in threadpool_info()
+                              if i["user_api"] == "blas"], current_threads()))(threads=2)
+    assert seen[0] and set(seen[0]) == {1}
+    assert seen[1] == min(2, available_cpus())
 
 
 @pytest.mark.slow

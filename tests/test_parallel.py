@@ -11,8 +11,17 @@ from helpers import ROOT, ends, run_cli, tube, tube_handles, twist
 from srarap_cli.io.mesh import Mesh, write_mesh
 from srarap_cli.runtime import parallel
 from srarap_cli.runtime.errors import InputError
-from srarap_cli.runtime.parallel import at_most, map_blocks, row_blocks, using_threads, worker_share
-from srarap_cli.solver import linalg, one_triangle, operators
+from srarap_cli.runtime.parallel import (
+    Plan,
+    at_most,
+    blocks,
+    cut,
+    map_blocks,
+    ordered_sum,
+    using_threads,
+    worker_share,
+)
+from srarap_cli.solver import linalg, one_triangle
 from srarap_cli.solver.multires.simplify import simplify_to_subset
 from srarap_cli.solver.oneshot import make_deformer
 from srarap_cli.solver.operators import cell_graph
@@ -113,8 +122,37 @@ def test_blocks_come_back_in_order_whatever_order_they_finish_in():
 
     with using_threads(3):
         assert map_blocks(slow_first, range(7)) == list(range(7))
-    assert row_blocks(0) == [] and row_blocks(5, 2) == [slice(0, 1), slice(1, 3), slice(3, 5)]
-    assert [b.stop - b.start for b in row_blocks(19_200, 16_384)] == [9_600, 9_600]
+    assert cut(0, 4) == [] and cut(5, 2) == [slice(0, 1), slice(1, 3), slice(3, 5)]
+    assert [b.stop - b.start for b in blocks(19_200)] == [9_600, 9_600]
+    assert [b.stop - b.start for b in blocks(600_000, "edges")] == [262_144, 262_144, 75_712]
+
+
+def test_small_work_runs_on_the_calling_thread_and_sums_alike():
+    """Issue 72: below a plan's ``alone_below`` the blocks run in turn on the calling thread
+    (a 19.2k-vertex coarse step was slower on two threads than on one), cut as ever, so the
+    ordered sum is the same bits either way."""
+    import threading
+
+    seen = set()
+
+    def part(rows):
+        seen.add(threading.get_ident())
+        return float(np.sin(np.arange(rows.start, rows.stop) * 0.37).sum())
+
+    small, large = blocks(40_000), blocks(400_000)
+    assert small.alone and not large.alone and len(small) == 3
+    with using_threads(3):
+        alone = ordered_sum(part, small)
+        assert seen == {threading.get_ident()}
+        shared = ordered_sum(part, large)
+    reference = 0.0
+    for rows in small:
+        reference += part(rows)
+    assert alone == reference
+    reference = 0.0
+    for rows in large:
+        reference += part(rows)
+    assert shared == reference
 
 
 def test_a_block_that_fails_raises_in_the_caller():
@@ -162,9 +200,12 @@ def test_the_thread_count_is_not_part_of_a_jobs_fingerprint(tmp_path):
 @pytest.fixture
 def every_threshold(monkeypatch):
     """Every size threshold of the parallel code crossed by a 2,000-vertex mesh: blocks of
-    96 rows, edge blocks of 500 edges, rslab for every symmetric matrix (its threads)."""
-    monkeypatch.setattr(parallel, "BLOCK_ROWS", 96)
-    monkeypatch.setattr(operators, "EDGE_BLOCK", 500)
+    96 rows, edge blocks of 500 edges, none run alone, rslab for every symmetric matrix (its
+    threads). The plans are one table: a kind added there must be added here."""
+    small = {"vertices": Plan(96), "values": Plan(384), "edges": Plan(500, even=False),
+             "collapses": Plan(24)}
+    assert small.keys() == parallel.PLANS.keys()
+    monkeypatch.setattr(parallel, "PLANS", small)
     monkeypatch.setenv(one_triangle.ENV, "rslab")
     monkeypatch.setattr(linalg, "ONE_TRIANGLE_FROM", 0)
 
@@ -198,7 +239,7 @@ def test_one_two_and_three_threads_give_the_same_bits(every_threshold, multires)
     T[T[:, 2] > 1] += [1.5, 0.0, -1.0]
     runs = [_solve(V, F, ids, T, k, multires=multires, tol=1e-7) for k in (1, 2, 3)]
     first = runs[0]
-    assert first.converged and len(V) > 20 * parallel.BLOCK_ROWS
+    assert first.converged and len(V) > 20 * parallel.PLANS["vertices"].size
     if multires != "off":
         assert first.multires is not None and first.coarse_iterations > 0
     for other in runs[1:]:
@@ -231,8 +272,8 @@ def _big_tube(tmp_path, length=10.0):
     """A 50k-vertex tube (above the block size, the edge block and multires's threshold) and
     a handle file twisting its top."""
     V, F = tube(length=length, rings=420, segments=120)
-    assert len(V) > max(2 * parallel.BLOCK_ROWS, 20_000)
-    assert cell_graph(V, F).I.size > operators.EDGE_BLOCK
+    assert len(V) > max(2 * parallel.PLANS["vertices"].size, 20_000)
+    assert cell_graph(V, F).I.size > parallel.PLANS["edges"].size
     write_mesh(str(tmp_path / "tube.obj"), Mesh.from_arrays(V, F))
     (tmp_path / "h.yaml").write_text(tube_handles("rotate: {axis: [0, 0, 1], angle_deg: 90}",
                                                   length))

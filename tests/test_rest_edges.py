@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from helpers import torus
 
-from srarap_cli.solver import operators
+from srarap_cli.runtime import parallel
 from srarap_cli.solver.energy import bending_energy
 from srarap_cli.solver.operators import cell_graph
 from srarap_cli.solver.quaternion import to_matrix
@@ -35,7 +35,7 @@ def test_rotated_divergence_is_the_sum_of_both_cells_rotated_edges(deformed_toru
 def test_edge_blocks_cover_every_edge_once(monkeypatch):
     V, F = torus(rings=10, segments=6)
     g = cell_graph(V, F)
-    monkeypatch.setattr(operators, "EDGE_BLOCK", 7)
+    monkeypatch.setitem(parallel.PLANS, "edges", parallel.Plan(7, even=False))
     blocks = g.edge_blocks()
     assert len(blocks) == -(-g.I.size // 7)
     assert np.array_equal(np.concatenate([np.arange(g.I.size)[e] for e in blocks]),
@@ -48,7 +48,7 @@ def test_sums_in_many_blocks_equal_one_block_and_brute_force(deformed_torus, mon
     g = cell_graph(V, F)
     edges = RestEdges(g, V)
     whole = edges.stretch(P), edges.stretch_total(P), bending_energy(g, R, 0.3, 2.0)
-    monkeypatch.setattr(operators, "EDGE_BLOCK", 13)  # blocks split one-rings
+    monkeypatch.setitem(parallel.PLANS, "edges", parallel.Plan(13, even=False))  # split rings
     s, total, bending = edges.stretch(P), edges.stretch_total(P), bending_energy(g, R, 0.3, 2.0)
     assert np.allclose(s, whole[0], rtol=1e-14)
     assert np.isclose(total, whole[1], rtol=1e-14)

@@ -37,7 +37,7 @@ def test_background_work_keeps_one_blas_thread_after_the_call_that_started_it_re
     # a multiresolution setup returns while its full-resolution factorization still runs
     from threadpoolctl import threadpool_limits
 
-    from srarap_cli.runtime.threads import single_threaded
+    from srarap_cli.runtime.parallel import numerics
     with threadpool_limits(limits=2, user_api="blas"):
         assert _blas_threads() == {2}  # the host's setting, which the solver must not see
         returned, seen = threading.Event(), {}
@@ -47,7 +47,7 @@ def test_background_work_keeps_one_blas_thread_after_the_call_that_started_it_re
             seen["during"] = _blas_threads()
             return "factored"
 
-        wait = single_threaded(lambda: background(factor))()
+        wait = numerics(lambda: background(factor))()
         seen["between"] = _blas_threads()
         returned.set()
         assert wait() == "factored"

@@ -9,22 +9,28 @@ bound, the hang ends with the child (SIGKILL, which nothing ignores) while srara
 130/143 with its one line, and the allocation fails against the child's address-space limit
 instead of taking the machine's memory.
 
-The child is forked (the reader's modules are loaded already: no start-up cost) and sends its
-result back pickled through a pipe; without ``os.fork`` (or with ``SRARAP_BOUNDED=0``) the
-call runs in this process, unbounded.
+The child is forked (the reader's modules are loaded already: no start-up cost) where this
+process runs a single thread, else a fresh interpreter (see :mod:`.forking`: a fork beside
+other threads can copy a lock one of them holds), and sends its result back pickled through
+a pipe; without ``os.fork`` (or with ``SRARAP_BOUNDED=0``) the call runs in this process,
+unbounded.
 """
 import os
 import pickle
 import select
 import signal
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from typing import Any
 
+from . import forking
+
 #: seconds a bounded call may take at least, and per megabyte of its input on top
 #: (``SRARAP_READ_SECONDS`` replaces the first: tests of hostile files use a short one)
 BASE_SECONDS, SECONDS_PER_MB = 20.0, 2.0
-ENV_SECONDS, ENV_OFF = "SRARAP_READ_SECONDS", "SRARAP_BOUNDED"
+ENV_SECONDS, ENV_OFF = "SRARAP_READ_SECONDS", forking.ENV_OFF
 
 
 class OutOfTime(Exception):
@@ -57,21 +63,65 @@ def run_bounded(func: Callable[..., Any], *args: Any, seconds: float,
 
 
 def start_bounded(func: Callable[..., Any], *args: Any, seconds: float,
-                  memory: int | None, here: bool = False) -> "Pending":
+                  memory: int | None, need: str = "bound") -> "Pending":
     """:func:`run_bounded` started, not waited for: this process goes on (reads another
     file, say) while the child works; :meth:`Pending.result` waits. Use it in a ``with``
-    block: leaving the block without the result (an error, a signal) kills the child. With
-    ``here`` (or without ``os.fork``, or with ``SRARAP_BOUNDED=0``) the call runs in this
-    process at :meth:`Pending.result`, unbounded."""
-    if here or not hasattr(os, "fork") or os.environ.get(ENV_OFF) == "0":
+    block: leaving the block without the result (an error, a signal) kills the child.
+    ``need`` (:func:`.forking.how`): ``bound`` runs in a child, forked or fresh; ``beside``
+    (work apart only to run side by side) in a forked child, or here, at
+    :meth:`Pending.result`, unbounded, where this process may not fork. A fresh child
+    imports ``func`` by name: a function of a module."""
+    way = forking.how(need)
+    if way == "here":
         return Pending(lambda: func(*args))
+    start = _fork if way == "fork" else _fresh
+    pid, read = start(func, args, memory)
+    return Pending(None, (pid, read, time.monotonic() + seconds, seconds))
+
+
+def _fork(func, args, memory):
     read, write = os.pipe()
     pid = os.fork()
     if pid == 0:  # the child: never returns
         os.close(read)
         _child(write, func, args, memory)
     os.close(write)
-    return Pending(None, (pid, read, time.monotonic() + seconds, seconds))
+    return pid, read
+
+
+#: what a fresh child runs: it dies with this process (Linux; the argument is this
+#: process's id), reads the call from its standard input and answers as a forked child does
+_FRESH = """\
+import os, pickle, sys
+try:
+    import ctypes
+    ctypes.CDLL(None).prctl(1, 9, 0, 0, 0)  # PR_SET_PDEATHSIG, SIGKILL
+except Exception:
+    pass
+if os.getppid() != int(sys.argv[1]):
+    sys.exit(1)
+payload = sys.stdin.buffer.read()
+from srarap_cli.runtime.bounded import _child
+out = os.dup(1)
+os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
+_child(out, *pickle.loads(payload))
+"""
+
+
+def _fresh(func, args, memory):
+    payload = pickle.dumps((func, args, memory), protocol=pickle.HIGHEST_PROTOCOL)
+    child = subprocess.Popen([sys.executable, "-c", _FRESH, str(os.getpid())],
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                             stderr=subprocess.DEVNULL)
+    assert child.stdin is not None and child.stdout is not None
+    read = os.dup(child.stdout.fileno())
+    child.stdout.close()
+    try:
+        child.stdin.write(payload)
+        child.stdin.close()
+    except OSError:  # it ended before it read: its answer says so (none)
+        pass
+    return child.pid, read
 
 
 def map_forked(func: Callable[[Any], Any], items: list, parts: int,
@@ -80,22 +130,20 @@ def map_forked(func: Callable[[Any], Any], items: list, parts: int,
     child process (forked: what this process holds, the children have), the last here; the
     results in order, pickled back. For independent CPU-bound work that holds the GIL (a
     file's parse, a matplotlib figure), where threads would take turns. One part, or a
-    process with other threads (a fork copies only the thread that makes it), runs here.
+    process that may not fork now (:func:`.forking.how`: other threads run), runs here.
 
     Examples
     --------
     >>> map_forked(lambda x: x * x, [1, 2, 3, 4, 5], parts=2, seconds=60)
     [1, 4, 9, 16, 25]
     """
-    import threading
     parts = max(1, min(parts, len(items)))
     cut = [len(items) * k // parts for k in range(parts + 1)]
     runs = [items[cut[k]:cut[k + 1]] for k in range(parts)]
-    here = parts == 1 or threading.active_count() > 1
 
     def run(part):
         return [func(x) for x in part]
-    calls = [start_bounded(run, part, seconds=seconds, memory=None, here=here)
+    calls = [start_bounded(run, part, seconds=seconds, memory=None, need="beside")
              for part in runs[:-1]]
     try:
         last = run(runs[-1])

@@ -16,16 +16,18 @@ host runs 2 threads, not 64).
 """
 import contextlib
 import contextvars
+import dataclasses
 import functools
 import math
 import os
 import threading
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
-from typing import TYPE_CHECKING, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from .errors import InputError
 from .numbers import digits_value
+from .threads import one_blas_thread
 
 if TYPE_CHECKING:
     import numpy as np
@@ -36,11 +38,49 @@ R = TypeVar("R")
 ENV = "SRARAP_THREADS"
 _CGROUP = "/sys/fs/cgroup"
 
-#: Rows per block of the per-iteration work (vertices, rotors): blocks are cut from the mesh,
-#: never from the thread count, so every thread count computes the same sums in the same
-#: order. 16k rows: a block's numpy calls take a millisecond or more against tens of
-#: microseconds to hand one to a thread, and a 62k-vertex coarse level still splits in four.
-BLOCK_ROWS = 1 << 14
+@dataclasses.dataclass(frozen=True)
+class Plan:
+    """How one kind of work is cut into blocks: at most ``size`` rows a block, of even sizes
+    (``even``) or in runs of ``size`` from the start; and below ``alone_below`` rows in all,
+    the blocks run in turn on the calling thread (hand-offs cost more than they share)."""
+
+    size: int
+    even: bool = True
+    alone_below: int = 0
+
+
+#: The one table of block plans. Blocks are cut from the mesh, never from the thread count,
+#: so every thread count computes the same sums in the same order.
+#: ``vertices``: per-vertex work (rotors, cells, positions); 16k rows: a block's numpy calls
+#: take a millisecond or more against tens of microseconds to hand one to a thread.
+#: ``values``: flat vectors, 4 values a vertex (conjugate gradients, Anderson's history).
+#: ``edges``: per-edge work summed into cells, runs of 2^18 (a cell's sum is split where a
+#: run ends, in the same place at any count).
+#: ``collapses``: candidate edge collapses, each a test of two rings (costlier a row).
+#: ``alone_below``: a coarse step of the 19.2k-vertex cylinder took 41.8 ms on one thread and
+#: 48.1 on two, the 76.8k one 166 and 172 ms, the 307k one 862 and 859 ms
+#: (``benchmarks/coarse_step.py``, 2 cores): below 64k vertices a map runs on the calling
+#: thread.
+PLANS: dict[str, Plan] = {
+    "vertices": Plan(1 << 14, alone_below=1 << 16),
+    "values": Plan(1 << 16, alone_below=4 << 16),
+    "edges": Plan(1 << 18, even=False, alone_below=6 << 16),
+    "collapses": Plan(1 << 12),
+}
+
+
+class Blocks(list):
+    """Blocks of a :class:`Plan` (or items that stand for them, :meth:`carrying`), and
+    whether they run on the calling thread alone (:attr:`alone`)."""
+
+    alone: bool = False
+
+    def carrying(self, items: Iterable[Any]) -> "Blocks":
+        """``items`` (one a block, in order) with these blocks' :attr:`alone`."""
+        out = Blocks(items)
+        out.alone = self.alone
+        return out
+
 
 _count: contextvars.ContextVar[int | None] = contextvars.ContextVar("srarap_threads",
                                                                    default=None)
@@ -264,37 +304,94 @@ def using_threads(count: int | None) -> Iterator[int]:
         _count.reset(token)
 
 
-def row_blocks(n: int, size: int | None = None) -> list[slice]:
-    """Consecutive ranges covering ``range(n)`` (none for 0): as many as blocks of at most
-    ``size`` rows (default :data:`BLOCK_ROWS`) need, of even sizes (19,200 rows make two
-    blocks of 9,600, not 16,384 and 2,816: neither thread waits long for the other). A
-    function of ``n`` and ``size`` alone.
+def numerics(func: Callable[..., R]) -> Callable[..., R]:
+    """The one wrapper of a solver's front door (a deformer's setup, its solve): the
+    wrapped call takes a keyword ``threads`` (None: the default, see :func:`using_threads`)
+    and runs on that many threads of ours, with one BLAS thread (see
+    :func:`.threads.one_blas_thread`).
 
     Examples
     --------
-    >>> row_blocks(5, 2)
+    >>> @numerics
+    ... def count():
+    ...     return current_threads()
+    >>> count(threads=1)
+    1
+    """
+    @functools.wraps(func)
+    def wrapper(*args: Any, threads: int | None = None, **kwargs: Any) -> R:
+        with one_blas_thread(), using_threads(threads):
+            return func(*args, **kwargs)
+
+    return wrapper
+
+
+def blocks(n: int, kind: str = "vertices") -> Blocks:
+    """Consecutive ranges covering ``range(n)`` (none for 0) by the plan of ``kind`` (see
+    :data:`PLANS`): as many as blocks of at most its size need, of even sizes (19,200 rows
+    make two blocks of 9,600, not 16,384 and 2,816: neither thread waits long for the
+    other), or runs of its size from the start. A function of ``n`` and the plan alone.
+
+    Examples
+    --------
+    >>> [b.stop - b.start for b in blocks(40_000)]
+    [13333, 13333, 13334]
+    >>> blocks(40_000).alone, blocks(10 ** 6).alone
+    (True, False)
+    """
+    plan = PLANS[kind]
+    out = Blocks(cut(n, plan.size) if plan.even else
+                 [slice(a, min(a + plan.size, n)) for a in range(0, n, plan.size)])
+    out.alone = n < plan.alone_below
+    return out
+
+
+def cut(n: int, size: int) -> list[slice]:
+    """``range(n)`` in the fewest consecutive ranges of at most ``size``, of even sizes.
+
+    Examples
+    --------
+    >>> cut(5, 2)
     [slice(0, 1, None), slice(1, 3, None), slice(3, 5, None)]
-    >>> [b.stop - b.start for b in row_blocks(10, 4)]
+    >>> [b.stop - b.start for b in cut(10, 4)]
     [3, 3, 4]
     """
-    size = size or BLOCK_ROWS
     count = -(-n // size)
     bounds = [k * n // count for k in range(count + 1)] if count else []
     return [slice(a, b) for a, b in zip(bounds, bounds[1:])]
 
 
-def splits(n: int) -> bool:
-    """Whether ``n`` rows make more than one block (else the caller's plain code runs)."""
-    return n > BLOCK_ROWS
+def splits(n: int, kind: str = "vertices") -> bool:
+    """Whether ``n`` rows make more than one block of ``kind`` (else the caller's plain code
+    runs: the same arithmetic, without the blocks' calls)."""
+    return n > PLANS[kind].size
 
 
-def map_blocks(func: Callable[[T], R], blocks: Iterable[T]) -> list[R]:
-    """``[func(b) for b in blocks]``, run on the current thread count; the results in block
-    order, whatever order the blocks finished in. The calling thread takes blocks too (a
-    hand-off to another thread costs tens of microseconds, a block a millisecond). One
-    thread, one block, or a call from inside a block (no nested pools: they could wait on
-    each other) runs them in turn here. A block that raises: the first such error in block
-    order is raised, once every block has ended.
+def ordered_sum(func: Callable[[T], Any], items: Iterable[T], start: Any = 0.0) -> Any:
+    """``start + func(b0) + func(b1) + ...``, the blocks mapped side by side
+    (:func:`map_blocks`) and their parts added in block order: the same sum at every thread
+    count. Parts may be floats or arrays (``start`` then an array of their shape, added to
+    in place).
+
+    Examples
+    --------
+    >>> ordered_sum(lambda s: float(sum(range(s.start, s.stop))), cut(10, 4))
+    45.0
+    """
+    total = start
+    for part in map_blocks(func, items):
+        total += part
+    return total
+
+
+def map_blocks(func: Callable[[T], R], items: Iterable[T]) -> list[R]:
+    """``[func(b) for b in items]`` (blocks, or what stands for them), run on the current
+    thread count; the results in block order, whatever order the blocks finished in. The
+    calling thread takes blocks too (a hand-off to another thread costs tens of
+    microseconds, a block a millisecond). One thread, one block, blocks too small to share
+    (:attr:`Blocks.alone`) or a call from inside a block (no nested pools: they could wait
+    on each other) runs them in turn here. A block that raises: the first such error in
+    block order is raised, once every block has ended.
 
     Examples
     --------
@@ -302,9 +399,10 @@ def map_blocks(func: Callable[[T], R], blocks: Iterable[T]) -> list[R]:
     ...     map_blocks(lambda k: k * k, range(5))
     [0, 1, 4, 9, 16]
     """
-    items = list(blocks)
+    alone = getattr(items, "alone", False)
+    items = list(items)
     count = min(current_threads(), len(items))
-    if count <= 1 or getattr(_inside, "busy", False):
+    if count <= 1 or alone or getattr(_inside, "busy", False):
         return [func(item) for item in items]
     results: list = [None] * len(items)
     errors: dict[int, BaseException] = {}
@@ -342,22 +440,22 @@ def map_blocks(func: Callable[[T], R], blocks: Iterable[T]) -> list[R]:
     return results
 
 
-def by_rows(func: Callable[..., object], out: "np.ndarray", *arrays: "np.ndarray",
-            size: int | None = None) -> "np.ndarray":
-    """``out[r] = func(*(a[r] for a in arrays))`` for each block ``r`` of
-    :func:`row_blocks` of ``len(out)`` (``size`` rows a block), blocks side by side; returns
-    ``out``. For row-wise work, whose rows come out the same however they are cut.
+def fill(func: Callable[..., object], out: "np.ndarray", *arrays: "np.ndarray",
+         kind: str = "vertices") -> "np.ndarray":
+    """``out[r] = func(*(a[r] for a in arrays))`` for each block ``r`` of :func:`blocks` of
+    ``len(out)`` rows of ``kind``, blocks side by side; returns ``out``. For row-wise work,
+    whose rows come out the same however they are cut.
 
     Examples
     --------
     >>> import numpy as np
-    >>> by_rows(lambda a: 2 * a, np.empty(3), np.arange(3.0))
+    >>> fill(lambda a: 2 * a, np.empty(3), np.arange(3.0))
     array([0., 2., 4.])
     """
     def block(rows):
         out[rows] = func(*(a[rows] for a in arrays))
 
-    map_blocks(block, row_blocks(len(out), size))
+    map_blocks(block, blocks(len(out), kind))
     return out
 
 

@@ -12,34 +12,22 @@ solve, which do not share data) keeps the results the same bit for bit.
 """
 import contextlib
 import contextvars
-import functools
 import os
 import signal
 import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
-from typing import Any, TypeVar, cast
+from typing import Any, TypeVar
 
 from .allocator import own_process
 from .environment import environ_changed
+from .forking import how
 from .signals import deferred
 
 T = TypeVar("T")
-F = TypeVar("F", bound=Callable[..., Any])
 
 _VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-
-
-def single_threaded(func: F) -> F:
-    """Run ``func`` with every BLAS library limited to one thread (see :func:`one_blas_thread`)."""
-
-    @functools.wraps(func)
-    def wrapper(*args, **kwargs):
-        with one_blas_thread():
-            return func(*args, **kwargs)
-
-    return cast(F, wrapper)
 
 
 _limit_lock = threading.Lock()
@@ -88,7 +76,7 @@ def _release_blas_control():
 
 def pin_process() -> None:
     """Ask the BLAS libraries for one thread before they load (the command line calls this
-    first; libraries already loaded keep their pools, which :func:`single_threaded` limits),
+    first; libraries already loaded keep their pools, which :func:`one_blas_thread` limits),
     and take the process's allocator policy (:func:`..allocator.own_process`: the command
     owns its process)."""
     for name in _VARIABLES:
@@ -141,15 +129,13 @@ def background(func: Callable[[], T]) -> Callable[[], T]:
 def worker_processes(preload: Sequence[str] = (), threads_ahead: bool = False) -> Iterator[Any]:
     """The multiprocessing context for srarap's worker processes, inside the block.
 
-    ``fork`` (a worker starts with everything imported) where this process runs a single
-    thread (Linux) and will while it starts them (not ``threads_ahead``: a Dask cluster's
-    own threads start first); else ``forkserver``: a fresh, single-threaded server started
-    here, which imports the modules ``preload`` names once, so that each worker forked from
-    it starts with them, and which ends with the block (a server left from an earlier
-    block, with another environment, is not reused); the platform's default where there is
-    no fork server (Windows). A fork beside other threads (a host's: a test runner's, a
-    notebook's; a cluster's) copies locks they may hold into a child that then waits on them
-    forever.
+    ``fork`` (a worker starts with everything imported) where this process may fork
+    (:func:`.forking.how`: it runs a single thread) and will while it starts them (not
+    ``threads_ahead``: a Dask cluster's own threads start first); else ``forkserver``: a
+    fresh, single-threaded server started here, which imports the modules ``preload`` names
+    once, so that each worker forked from it starts with them, and which ends with the block
+    (a server left from an earlier block, with another environment, is not reused); the
+    platform's default where there is no fork server (Windows).
 
     Examples
     --------
@@ -159,7 +145,7 @@ def worker_processes(preload: Sequence[str] = (), threads_ahead: bool = False) -
     """
     import multiprocessing
 
-    if sys.platform.startswith("linux") and not threads_ahead and _threads() == 1:
+    if sys.platform.startswith("linux") and not threads_ahead and how("workers") == "fork":
         yield multiprocessing.get_context("fork")
     elif "forkserver" not in multiprocessing.get_all_start_methods():
         yield multiprocessing.get_context()
@@ -262,11 +248,3 @@ def _children(pid: int) -> list[int]:
         if int(fields[1]) == pid and fields[0] != b"Z":
             found.append(int(entry))
     return found
-
-
-def _threads() -> int:
-    """How many threads this process runs (all of them, not only Python's)."""
-    try:
-        return len(os.listdir("/proc/self/task"))
-    except OSError:
-        return threading.active_count() + 1  # unknown: never taken for a single thread

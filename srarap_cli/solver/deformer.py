@@ -14,8 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.sparse import csgraph
 
-from ..runtime.parallel import using_threads
-from ..runtime.threads import single_threaded
+from ..runtime.parallel import numerics
 from ..runtime.warning_codes import note
 from . import api_checks
 from .drivers import ACCEL_DRIVERS, DRIVERS, Monitor
@@ -101,15 +100,14 @@ class Deformer:
     (True, True)
     """
 
-    @single_threaded
     def __init__(self, V: ArrayLike, F: ArrayLike, constrained: ArrayLike, *,
                  settings: Settings | None = None, area: float | None = None,
                  labels: ArrayLike | None = None, prepare: bool = True,
                  **options: Any) -> None:
         self.settings = with_keywords(settings, options, ("setup", "solve"), "Deformer")
-        with using_threads(self.settings.threads):
-            self._build(V, F, constrained, area, labels, prepare)
+        self._build(V, F, constrained, area, labels, prepare, threads=self.settings.threads)
 
+    @numerics
     def _build(self, V, F, constrained, area, labels, prepare):
         s = self.settings
         self.V, self.F = api_checks.mesh_arrays(V, F)
@@ -218,7 +216,6 @@ class Deformer:
         (``tol``: default the solver's setting)."""
         return LocalGlobalStep(self, targets, self.settings.tol if tol is None else tol)
 
-    @single_threaded
     def solve(self, targets: ArrayLike, *, initial: tuple[np.ndarray, np.ndarray] | None = None,
               callback: Callable[[dict], None] | None = None,
               settings: Settings | None = None, start: str | None = None,
@@ -256,9 +253,9 @@ class Deformer:
         DeformResult
         """
         s = solve_settings(self.settings, settings, options, "solve")
-        with using_threads(s.threads):
-            return self._solve(s, targets, initial, callback, start, driver)
+        return self._solve(s, targets, initial, callback, start, driver, threads=s.threads)
 
+    @numerics
     def _solve(self, s, targets, initial, callback, start, driver):
         targets = api_checks.targets(targets, len(self.constrained))
         if initial is not None:

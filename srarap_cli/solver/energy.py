@@ -8,9 +8,11 @@ surface area, ``deg_i`` the number of neighbours. The ``min`` makes the bending 
 the sign of a quaternion (``q`` and ``-q`` are the same rotation).
 """
 
+from functools import partial
+
 import numpy as np
 
-from ..runtime.parallel import map_blocks, row_blocks
+from ..runtime.parallel import blocks, ordered_sum
 from .operators import CellGraph
 from .quaternion import rotate
 
@@ -47,12 +49,13 @@ def membrane_from_covariance(S: np.ndarray, stretch_total: float, Rm: np.ndarray
     S : (n, 3, 3) from RestEdges.cross; stretch_total : float, RestEdges.stretch_total;
     Rm : (n, 3, 3) rotation matrices
     """
-    parts = map_blocks(lambda rows: float(np.einsum("nab,nab->", Rm[rows], S[rows])),
-                       row_blocks(len(S)))
-    total = 0.0
-    for part in parts:  # in block order: the same sum at every thread count
-        total += part
+    total = ordered_sum(partial(_traces, Rm, S), blocks(len(S)))
     return float(stretch_total - 2.0 * total)
+
+
+def _traces(Rm, S, rows):
+    """``sum_i trace(R_i^T S_i)`` over a block of cells."""
+    return float(np.einsum("nab,nab->", Rm[rows], S[rows]))
 
 
 def accurate_enough(value: float, scale: float, tol: float) -> bool:
@@ -71,15 +74,14 @@ def bending_energy(graph: CellGraph, R: np.ndarray, alpha: float, area: float) -
     if alpha == 0:
         return 0.0
     sq = np.einsum("ij,ij->i", R, R)
-
-    def block(e):
-        I, J = graph.I[e], graph.J[e]
-        dots = np.einsum("ij,ij->i", np.take(R, I, axis=0), np.take(R, J, axis=0))
-        # |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b ; the min takes the sign that agrees
-        dist = np.take(sq, I) + np.take(sq, J) - 2.0 * np.abs(dots)
-        return float(np.maximum(dist, 0.0) @ (1.0 / np.take(graph.degree, I)))
-
-    total = 0.0
-    for part in map_blocks(block, graph.edge_blocks()):  # summed in block order
-        total += part
+    total = ordered_sum(partial(_bending_part, graph, R, sq), graph.edge_blocks())
     return float(alpha * area * total)
+
+
+def _bending_part(graph, R, sq, e):
+    """The bending sum over a block ``e`` of edges (``sq``: each rotor's squared norm)."""
+    I, J = graph.I[e], graph.J[e]
+    dots = np.einsum("ij,ij->i", np.take(R, I, axis=0), np.take(R, J, axis=0))
+    # |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b ; the min takes the sign that agrees
+    dist = np.take(sq, I) + np.take(sq, J) - 2.0 * np.abs(dots)
+    return float(np.maximum(dist, 0.0) @ (1.0 / np.take(graph.degree, I)))

@@ -8,6 +8,7 @@ import scipy.sparse.linalg as spla
 from scipy.sparse import csr_matrix
 
 from ..runtime.errors import SingularSystemError
+from ..runtime.forking import how
 from ..runtime.fpu import subnormals_flushed
 from ..runtime.fresh_process import run_fresh
 from ..runtime.limits import is_out_of_memory
@@ -194,9 +195,10 @@ def fill_order(A: csr_matrix) -> np.ndarray:
     """METIS nested dissection order of the graph of a symmetric sparse matrix's stored
     off-diagonal entries (explicit zeros count); vertices without any come first.
 
-    From :data:`APART_FROM` linked vertices on, METIS runs in a fresh interpreter
-    (:mod:`..runtime.fresh_process`): it keeps the GIL for its whole run, which stalled the
-    simplification running beside it. The order is the same either way.
+    From :data:`APART_FROM` linked vertices on, where other threads run (the simplification
+    beside it: :func:`..runtime.forking.how` ``gil``), METIS runs in a fresh interpreter
+    (:mod:`..runtime.fresh_process`): it keeps the GIL for its whole run, which stalled
+    them. The order is the same either way.
 
     Parameters
     ----------
@@ -216,7 +218,8 @@ def fill_order(A: csr_matrix) -> np.ndarray:
     ids = np.flatnonzero(linked)
     sub = graph[ids][:, ids]
     sub.sort_indices()
-    found = run_fresh(_DISSECTION, _adjacency_bytes(sub)) if ids.size >= APART_FROM else None
+    apart = ids.size >= APART_FROM and how("gil") == "fresh"
+    found = run_fresh(_DISSECTION, _adjacency_bytes(sub)) if apart else None
     order = (np.frombuffer(found, dtype="<i8") if found is not None and _is_permutation(found, ids.size)
              else _dissection(pymetis, sub.indptr, sub.indices))
     return np.concatenate([np.flatnonzero(~linked), ids[order]])

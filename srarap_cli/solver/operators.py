@@ -5,7 +5,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from ..runtime.parallel import row_blocks
+from ..runtime.parallel import Blocks, blocks
 from .group_rotations import label_sum
 from .libigl import igl
 from .linalg import fill_order
@@ -16,10 +16,6 @@ WEIGHT_KINDS = ("cotan", "cotan-clamped", "uniform")
 # Half-cotangents are bounded: an angle under ~0.06 degrees (a needle) would otherwise give
 # a weight that swamps its neighbours and the conditioning of every solve.
 MAX_HALF_COT = 500.0
-# Per-edge temporaries are made this many edges at a time: whole, a 738k-vertex mesh's 4.4M
-# directed edges made 0.1-0.3 GB of them at once in every iteration. Meshes under ~40k
-# vertices fit in one block, where the sums are those of a single pass.
-EDGE_BLOCK = 1 << 18
 
 
 @dataclass(frozen=True)
@@ -77,12 +73,12 @@ class CellGraph:
         return np.concatenate([[0], np.cumsum(self.degree)])
 
     @cached_property
-    def blocks(self) -> list[tuple[slice, slice]]:
+    def blocks(self) -> Blocks:
         """The per-iteration work's blocks for threads: (vertex range, its edges' range) pairs
-        of :func:`~srarap_cli.runtime.parallel.row_blocks`, in order."""
-        indptr = self.indptr
-        return [(rows, slice(int(indptr[rows.start]), int(indptr[rows.stop])))
-                for rows in row_blocks(self.n)]
+        of :func:`~srarap_cli.runtime.parallel.blocks`, in order."""
+        indptr, rows = self.indptr, blocks(self.n)
+        return rows.carrying((r, slice(int(indptr[r.start]), int(indptr[r.stop])))
+                             for r in rows)
 
     def fill_order(self, rows: np.ndarray | None = None) -> np.ndarray:
         """A fill-reducing order of the vertices ``rows`` (default all), as positions into
@@ -97,11 +93,13 @@ class CellGraph:
         rank[order] = np.arange(self.n)
         return np.argsort(rank[rows], kind="stable")
 
-    def edge_blocks(self, m: int | None = None) -> list[slice]:
-        """Slices of at most :data:`EDGE_BLOCK` consecutive edges that cover the first ``m``
-        (default all) edges."""
-        m = self.I.size if m is None else m
-        return [slice(a, min(a + EDGE_BLOCK, m)) for a in range(0, m, EDGE_BLOCK)]
+    def edge_blocks(self, m: int | None = None) -> Blocks:
+        """The ``edges`` blocks (:data:`~srarap_cli.runtime.parallel.PLANS`) of the first
+        ``m`` (default all) edges: per-edge temporaries are made a block at a time (whole, a
+        738k-vertex mesh's 4.4M directed edges made 0.1-0.3 GB of them at once in every
+        iteration); meshes under ~40k vertices fit in one block, where the sums are those of
+        a single pass."""
+        return blocks(self.I.size if m is None else m, "edges")
 
     def cell_sum(self, values: np.ndarray, edges: slice = slice(None)) -> np.ndarray:
         """Sum per-edge ``values`` of shape (m, ...) into their source vertex: (n, ...);
@@ -113,8 +111,8 @@ class CellGraph:
         return sums.reshape((self.n,) + values.shape[1:])
 
 
-def row_views(A: sp.csr_matrix) -> list[tuple[slice, sp.csr_matrix]]:
-    """``A``'s :func:`~srarap_cli.runtime.parallel.row_blocks` with their rows of ``A``,
+def row_views(A: sp.csr_matrix) -> Blocks:
+    """``A``'s :func:`~srarap_cli.runtime.parallel.blocks` with their rows of ``A``,
     which share its values and indices (no copy).
 
     Built without scipy's constructor, whose format check copies a slice of less than half
@@ -127,14 +125,15 @@ def row_views(A: sp.csr_matrix) -> list[tuple[slice, sp.csr_matrix]]:
     >>> [bool(np.shares_memory(B.data, A.data)) for rows, B in row_views(A)]
     [True, True, True]
     """
+    rows_of_a = blocks(A.shape[0])
     out = []
-    for rows in row_blocks(A.shape[0]):
+    for rows in rows_of_a:
         lo, hi = int(A.indptr[rows.start]), int(A.indptr[rows.stop])
         block = sp.csr_matrix((rows.stop - rows.start, A.shape[1]), dtype=A.dtype)
         block.data, block.indices = A.data[lo:hi], A.indices[lo:hi]
         block.indptr = (A.indptr[rows.start:rows.stop + 1] - lo).astype(A.indices.dtype)
         out.append((rows, block))
-    return out
+    return rows_of_a.carrying(out)
 
 
 def mesh_area(V: np.ndarray, F: np.ndarray) -> float:

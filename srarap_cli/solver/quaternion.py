@@ -8,7 +8,7 @@ algebra the same rotor is ``w + B`` with the bivector ``B`` dual to ``(x, y, z)`
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..runtime.parallel import by_rows, splits
+from ..runtime.parallel import fill, splits
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
 
@@ -82,7 +82,7 @@ def to_matrix(q: np.ndarray) -> np.ndarray:
     """Rotation matrices of unit quaternions: ``(..., 4) -> (..., 3, 3)``."""
     q = np.asarray(q, dtype=float)
     if q.ndim == 2 and splits(len(q)):  # a mesh's rotors: by blocks, on the threads
-        return by_rows(_to_matrix, np.empty((len(q), 3, 3)), q)
+        return fill(_to_matrix, np.empty((len(q), 3, 3)), q)
     return _to_matrix(q)
 
 
@@ -149,7 +149,7 @@ def normalize(q: np.ndarray, fallback: np.ndarray) -> np.ndarray:
     """
     q, fallback = np.asarray(q, dtype=float), np.asarray(fallback, dtype=float)
     if splits(len(q)) and fallback.shape == q.shape:
-        return by_rows(_normalize, np.empty(q.shape), q, fallback)
+        return fill(_normalize, np.empty(q.shape), q, fallback)
     return _normalize(q, fallback)
 
 
@@ -191,7 +191,7 @@ def from_matrix(M: np.ndarray) -> np.ndarray:
 def align_hemisphere(q: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """Flip the sign of rows of ``q`` that point away from ``reference`` (same rotation)."""
     if splits(len(q)):
-        return by_rows(_align, np.empty(np.shape(q)), q, reference)
+        return fill(_align, np.empty(np.shape(q)), q, reference)
     return _align(q, reference)
 
 

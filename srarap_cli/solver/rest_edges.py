@@ -1,9 +1,11 @@
 """Rest-shape edge data as sparse operators, so per-iteration sums are sparse products."""
 
+from functools import partial
+
 import numpy as np
 import scipy.sparse as sp
 
-from ..runtime.parallel import map_blocks
+from ..runtime.parallel import map_blocks, ordered_sum
 from .operators import CellGraph, row_views
 from .quaternion import to_matrix
 
@@ -47,7 +49,8 @@ class RestEdges:
                                    indices, indptr), shape=(n, n), copy=False)
                     for b in range(3)]
         views = [row_views(matrix) for matrix in matrices]
-        self._blocks = [(rows, [v[k][1] for v in views]) for k, (rows, _) in enumerate(views[0])]
+        self._blocks = views[0].carrying((rows, [v[k][1] for v in views])
+                                         for k, (rows, _) in enumerate(views[0]))
         self._half: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._rest_total = float(self.rest_scale.sum())
 
@@ -108,7 +111,7 @@ class RestEdges:
         s = self.rest_scale.copy()
         # each block's sums added in block order: a cell whose edges two blocks share gets
         # its two parts in the same order at every thread count
-        for first, part in map_blocks(block, [e for e in g.edge_blocks() if e.stop > e.start]):
+        for first, part in map_blocks(block, g.edge_blocks()):
             s[first:first + part.size] += part
         return s
 
@@ -123,13 +126,7 @@ class RestEdges:
             self._half = g.I[half], g.J[half], g.c[half]
         I, J, c = self._half
 
-        def block(e):
-            d = np.take(P, J[e], axis=0) - np.take(P, I[e], axis=0)
-            return float(c[e] @ np.einsum("ij,ij->i", d, d))
-
-        total = 0.0
-        for part in map_blocks(block, self.graph.edge_blocks(I.size)):
-            total += part
+        total = ordered_sum(partial(_weighted_lengths, P, I, J, c), self.graph.edge_blocks(I.size))
         return 2.0 * total + self._rest_total
 
     def rotated_divergence(self, R: np.ndarray, Rm: np.ndarray | None = None) -> np.ndarray:
@@ -155,6 +152,12 @@ class RestEdges:
 
         map_blocks(block, self._blocks)
         return out
+
+
+def _weighted_lengths(P, I, J, c, e):
+    """``sum c_ij |p_j - p_i|^2`` over a block ``e`` of the edges ``(I, J)``."""
+    d = np.take(P, J[e], axis=0) - np.take(P, I[e], axis=0)
+    return float(c[e] @ np.einsum("ij,ij->i", d, d))
 
 
 def _int32(a: np.ndarray) -> np.ndarray:

@@ -1,7 +1,6 @@
 """Read and write mesh files by format; see the package's docstring."""
 import contextlib
 import os
-import threading
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import replace
 
@@ -67,8 +66,8 @@ def reading_beside(path: str | None) -> Iterator[Callable[[], Mesh | None]]:
     gets a function that waits for the mesh (None for no ``path``) or raises what
     :func:`read_mesh` raises. Leaving the block early stops the child. Two 738k-vertex OBJ
     files, one each side, take the time of one (a parse holds the GIL: threads would not).
-    Read here, at the call, where other threads run (a fork copies only the thread that
-    makes it) or where ``SRARAP_BOUNDED=0``.
+    Read here, at the call, where this process may not fork (other threads run: see
+    :mod:`srarap_cli.runtime.forking`) or where ``SRARAP_BOUNDED=0``.
     """
     if path is None:
         yield lambda: None
@@ -78,7 +77,7 @@ def reading_beside(path: str | None) -> Iterator[Callable[[], Mesh | None]]:
     except (OSError, TypeError, ValueError):
         seconds = time_bound(0)  # read_mesh says what is wrong with the path
     with start_bounded(read_mesh, path, seconds=seconds, memory=None,
-                       here=threading.active_count() > 1) as call:
+                       need="beside") as call:
         def result() -> Mesh | None:
             try:
                 return call.result()

@@ -48,12 +48,12 @@ rejected, and the plain steps taken instead climb to the fixed point's energy (l
 ``fallback`` rows whose energy rises). The result is still the plain iteration's fixed point
 (2.9e-8 of the diagonal from it there), but those steps cost two local steps each.
 """
+from functools import partial
 from typing import Any
 
 import numpy as np
 
-from ...runtime import parallel
-from ...runtime.parallel import by_rows, map_blocks, row_blocks
+from ...runtime.parallel import blocks, fill, map_blocks, ordered_sum
 from ..quaternion import align_hemisphere, normalize
 from ..state import State
 from ..step import LocalGlobalStep
@@ -127,7 +127,7 @@ class AndersonMixer:
         def block(cols):  # einsum sums in double without a double copy of the history
             out[cols] = g[cols] - np.einsum("i,ij->j", theta, dG[:, cols], dtype=float)
 
-        map_blocks(block, row_blocks(g.size, _flat_block()))
+        map_blocks(block, blocks(g.size, "values"))
         return out
 
     def _push(self, df, dg):
@@ -140,8 +140,8 @@ class AndersonMixer:
             self._gram = np.empty((self.depth, self.depth))
         assert self._dG is not None and self._gram is not None  # allocated with _dF
         i = self._next
-        by_rows(lambda part: part / scale, self._dF[i], df, size=_flat_block())
-        by_rows(lambda part: part / scale, self._dG[i], dg, size=_flat_block())
+        fill(lambda part: part / scale, self._dF[i], df, kind="values")
+        fill(lambda part: part / scale, self._dG[i], dg, kind="values")
         self._count = min(self._count + 1, self.depth)
         row = _products(self._dF[:self._count], self._dF[i])
         self._gram[i, :self._count] = row
@@ -149,20 +149,16 @@ class AndersonMixer:
         self._next = (i + 1) % self.depth
 
 
-def _flat_block():
-    """Entries per block of flattened rotors (4 a vertex) that threads share."""
-    return 4 * parallel.BLOCK_ROWS
-
-
 def _products(rows, v):
     """``rows @ v`` summed in double precision, whatever the storage of ``rows``: by blocks
     of columns, their partial sums added in block order (the same at any thread count)."""
-    parts = map_blocks(lambda cols: np.einsum("ij,j->i", rows[:, cols], v[cols], dtype=float),
-                       row_blocks(v.size, _flat_block()))
-    total = np.zeros(rows.shape[0])
-    for part in parts:
-        total += part
-    return total
+    return ordered_sum(partial(_columns_product, rows, v), blocks(v.size, "values"),
+                       np.zeros(rows.shape[0]))
+
+
+def _columns_product(rows, v, cols):
+    """``rows[:, cols] @ v[cols]`` in double precision."""
+    return np.einsum("ij,j->i", rows[:, cols], v[cols], dtype=float)
 
 
 def anderson_iteration(step: LocalGlobalStep, state: State, monitor: Monitor,

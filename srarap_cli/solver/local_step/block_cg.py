@@ -12,8 +12,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ...runtime import parallel
-from ...runtime.parallel import map_blocks, row_blocks
+from ...runtime.parallel import blocks as cut_blocks
+from ...runtime.parallel import map_blocks, ordered_sum
 
 
 def conjugate_gradients(product: Callable[[np.ndarray, np.ndarray], float],
@@ -46,7 +46,7 @@ def conjugate_gradients(product: Callable[[np.ndarray, np.ndarray], float],
     >>> info, np.allclose(A @ x, [1.0, 2.0])
     (0, True)
     """
-    blocks = row_blocks(b.size, 4 * parallel.BLOCK_ROWS)
+    blocks = cut_blocks(b.size, "values")
     b_norm = np.sqrt(_dot(b, b, blocks))
     tol = max(float(atol), float(rtol) * b_norm)
     x = np.zeros_like(b)
@@ -68,10 +68,7 @@ def conjugate_gradients(product: Callable[[np.ndarray, np.ndarray], float],
 
 def _dot(a, b, blocks):
     """``a . b`` as per-block sums added in block order."""
-    total = 0.0
-    for part in map_blocks(lambda s: float(a[s] @ b[s]), blocks):
-        total += part
-    return total
+    return ordered_sum(lambda s: float(a[s] @ b[s]), blocks)
 
 
 def _update(p, z, beta, blocks):
@@ -93,7 +90,4 @@ def _step(x, r, p, q, alpha, blocks):
         r[s] -= alpha * q[s]
         return float(r[s] @ r[s])
 
-    total = 0.0
-    for part in map_blocks(block, blocks):
-        total += part
-    return total
+    return ordered_sum(block, blocks)

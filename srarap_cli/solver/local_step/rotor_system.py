@@ -33,7 +33,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse import csr_matrix
 
-from ...runtime.parallel import by_rows, map_blocks, row_blocks
+from ...runtime.parallel import blocks, fill, map_blocks, ordered_sum
 from ..linalg import factor
 from ..operators import row_views
 from ..quaternion import normalize
@@ -99,21 +99,21 @@ class RotorSystem:
             D[rows] = membrane_matrices(S[rows], s[rows])
             return max(float(D[rows].max(initial=0)), -float(D[rows].min(initial=0)))
 
-        size = max(map_blocks(membrane, row_blocks(len(s))), default=0.0)
+        size = max(map_blocks(membrane, blocks(len(s))), default=0.0)
         shift = _REL_SHIFT * max(float(self.tau.max(initial=0)), size)
 
         def scale(rows):  # in place: each (n, 4, 4) temporary is 94 MB at 738k vertices
             D[rows] *= self.sigma[rows, None, None]
             D[rows, _DIAG, _DIAG] += (self.tau[rows] + shift)[:, None]
 
-        map_blocks(scale, row_blocks(len(s)))
+        map_blocks(scale, blocks(len(s)))
         return D
 
     def free_system(self, D: np.ndarray, R_prev: np.ndarray, R_fixed: np.ndarray
                     ) -> tuple["FreeRotorMatrix", np.ndarray]:
         """The free rotors' matrix (a :class:`FreeRotorMatrix`) and right-hand side
         (flattened, 4 per free vertex)."""
-        free = by_rows(lambda ids: np.take(D, ids, axis=0), np.empty((self.free.size, 4, 4)),
+        free = fill(lambda ids: np.take(D, ids, axis=0), np.empty((self.free.size, 4, 4)),
                        self.free)
         A = FreeRotorMatrix(free, self._coupling, self._coupling_blocks)
         self._preconditioner(A.D)
@@ -193,10 +193,7 @@ class FreeRotorMatrix(spla.LinearOperator):
             out[rows] = part
             return float(np.einsum("ij,ij->", X[rows], part))
 
-        total = 0.0
-        for part in map_blocks(block, self._blocks):
-            total += part
-        return total
+        return ordered_sum(block, self._blocks)
 
     def tocsr(self) -> csr_matrix:
         """The assembled sparse matrix (for the direct fallback)."""

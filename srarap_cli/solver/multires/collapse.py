@@ -17,8 +17,7 @@ from functools import partial
 import numpy as np
 import scipy.sparse as sp
 
-from ...runtime import parallel
-from ...runtime.parallel import by_rows
+from ...runtime.parallel import fill
 from ..group_rotations import label_sum
 from ..mesh_checks import distinct_ids, edge_counts
 from ..operators import triangle_normals
@@ -257,8 +256,8 @@ def _keeps_shape(V, surface, rings, u, v):
     """Whether moving u's triangles onto v keeps each one's orientation (against the
     triangle it was and against the input surface) and a fair shape; collapse by collapse,
     blocks of them side by side."""
-    return by_rows(partial(_block_keeps_shape, V, surface, rings), np.empty(u.size, dtype=bool),
-                   u, v, size=max(1, parallel.BLOCK_ROWS // 4))
+    return fill(partial(_block_keeps_shape, V, surface, rings), np.empty(u.size, dtype=bool),
+                u, v, kind="collapses")
 
 
 def _block_keeps_shape(V, surface, rings, u, v):
@@ -424,4 +423,4 @@ def _costs(Q, lifted, own, u, v):
         return np.maximum(np.einsum("ik,ik->i", np.take(Q, uu, axis=0),
                                     np.take(lifted, vv, axis=0)) + np.take(own, vv), 0.0)
 
-    return by_rows(block, np.empty(u.size), u, v)
+    return fill(block, np.empty(u.size), u, v)

@@ -13,11 +13,11 @@ from numpy.typing import ArrayLike
 
 from ...runtime import memory
 from ...runtime.errors import NumericalError
-from ...runtime.parallel import using_threads
+from ...runtime.parallel import numerics
 from ...runtime.stages import begun as stage_begun
 from ...runtime.stages import deeper
 from ...runtime.stages import ended as stage_ended
-from ...runtime.threads import background, single_threaded
+from ...runtime.threads import background
 from ...runtime.warning_codes import note, reworded
 from .. import api_checks
 from ..deformer import Deformer, solve_settings
@@ -141,16 +141,15 @@ class MultiresDeformer:
     True
     """
 
-    @single_threaded
     def __init__(self, V: ArrayLike, F: ArrayLike, constrained: ArrayLike,
                  labels: ArrayLike | None = None, *, settings: Settings | None = None,
                  size: int | None = None, cache: str | None = None, area: float | None = None,
                  **options: Any) -> None:
         self.settings = with_keywords(settings, options, ("setup", "solve", "build"),
                                       "MultiresDeformer")
-        with using_threads(self.settings.threads):
-            self._setup(V, F, constrained, labels, size, cache, area)
+        self._setup(V, F, constrained, labels, size, cache, area, threads=self.settings.threads)
 
+    @numerics
     def _setup(self, V, F, constrained, labels, size, cache, area):
         self.mode = self.settings.multires_mode
         start, peak = time.perf_counter(), memory.start()
@@ -301,7 +300,6 @@ class MultiresDeformer:
         self._row[self._known] = np.arange(self._known.size)
         self.solver = DirichletSolver(self._fine.graph.laplacian, self._known)
 
-    @single_threaded
     def solve(self, targets: ArrayLike, *, initial: tuple[np.ndarray, np.ndarray] | None = None,
               callback: Callable[[dict], None] | None = None,
               settings: Settings | None = None, start: str | None = None,
@@ -311,9 +309,9 @@ class MultiresDeformer:
         :class:`~srarap_cli.solver.result.DeformResult` with its ``multires`` part."""
         begin = time.perf_counter()
         s = solve_settings(self.settings, settings, options, "solve")
-        with using_threads(s.threads):
-            return self._solve(s, targets, initial, callback, start, begin)
+        return self._solve(s, targets, initial, callback, start, begin, threads=s.threads)
 
+    @numerics
     def _solve(self, s, targets, initial, callback, start, begin):
         targets = api_checks.targets(targets, len(self.constrained))
         if initial is not None:
