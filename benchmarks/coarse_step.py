@@ -10,12 +10,16 @@ maps, thread hand-offs, small numpy calls) shows. The step is the one
 hemispheres.
 
 Thread counts run interleaved, round by round, so a machine that slows down midway hits
-them alike; figures are medians. Missing meshes are made into ``out/``.
+them alike; figures are medians. Missing meshes are made into ``out/``. ``--base REV`` runs
+REV (a git worktree in ``out/base-REV``, on ``PYTHONPATH``) and the working tree in
+alternating processes (each alternating the counts five times) and prints both.
 
 Run: python benchmarks/coarse_step.py [--levels 1] [--threads 1,2] [--rounds 7] [--steps 10]
+     [--base REV]
 """
 import argparse
 import cProfile
+import json
 import os
 import pstats
 import statistics
@@ -90,14 +94,63 @@ def profiled(step, y, threads, steps):
     return calls / steps, 1e3 * solves / steps, handed[0] / steps
 
 
+def one_round(args, counts):
+    """This process's tree, one round: per thread count, seconds a step, then the profile's
+    figures (printed as JSON)."""
+    step, y, n = coarse_map(args.levels)
+    seconds = {t: [] for t in counts}
+    for _ in range(5):  # the counts alternated inside the process too
+        for t in counts:
+            seconds[t].append(timed(step, y, t, args.steps))
+    out = {"n": n}
+    for t in counts:
+        out[t] = [statistics.median(seconds[t]), *profiled(step, y, t, args.steps)]
+    print(json.dumps(out))
+
+
+def paired(args, counts):
+    """Base and head in alternating processes; medians per tree and thread count."""
+    root = os.path.dirname(HERE)
+    tree = os.path.join(OUT, f"base-{args.base}")
+    if not os.path.isdir(tree):
+        subprocess.run(["git", "-C", root, "worktree", "add", "--detach", tree, args.base],
+                       check=True, capture_output=True)
+    runs = {"base": [], "head": []}
+    for _ in range(args.rounds):
+        for name, path in (("base", tree), ("head", root)):
+            env = {**os.environ, "PYTHONPATH": path}
+            done = subprocess.run([sys.executable, __file__, "--one", "--levels",
+                                   str(args.levels), "--threads", args.threads, "--steps",
+                                   str(args.steps)], env=env, capture_output=True, text=True,
+                                  check=True)
+            runs[name].append(json.loads(done.stdout.strip().splitlines()[-1]))
+    n = runs["head"][0]["n"]
+    print(f"coarse step of {n} vertices, base {args.base} against the working tree, "
+          f"medians of {args.rounds} alternating processes of {args.steps} steps "
+          f"({parallel.available_cpus()} CPUs)")
+    print(f"{'tree':>5} {'threads':>7} {'ms/step':>8} {'solves ms':>9} {'calls':>7} "
+          f"{'hand-offs':>9}")
+    for name in ("base", "head"):
+        for t in counts:
+            rows = [r[str(t)] for r in runs[name]]
+            ms, calls, solves, handed = (statistics.median(r[k] for r in rows) for k in range(4))
+            print(f"{name:>5} {t:>7} {1e3 * ms:8.1f} {solves:9.1f} {calls:7.0f} {handed:9.1f}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--levels", type=int, default=1)
     ap.add_argument("--threads", default="1,2")
     ap.add_argument("--rounds", type=int, default=7)
     ap.add_argument("--steps", type=int, default=10)
+    ap.add_argument("--base")
+    ap.add_argument("--one", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     counts = [int(t) for t in args.threads.split(",")]
+    if args.one:
+        return one_round(args, counts)
+    if args.base:
+        return paired(args, counts)
     step, y, n = coarse_map(args.levels)
     seconds = {t: [] for t in counts}
     for _ in range(args.rounds):

@@ -87,31 +87,17 @@ class RestEdges:
 
     def cross(self, P: np.ndarray) -> np.ndarray:
         """``S_i = sum_j c_ij p_ij q_ij^T``: (n, 3, 3), from sparse products by blocks of rows."""
-        P = np.asarray(P, dtype=float)
         S = np.empty((self.graph.n, 3, 3))
-
-        def block(item):
-            rows, matrices = item
-            for b, matrix in enumerate(matrices):
-                S[rows, :, b] = matrix @ P
-
-        map_blocks(block, self._blocks)
+        map_blocks(partial(_cross_block, np.asarray(P, dtype=float), S), self._blocks)
         return S
 
     def stretch(self, P: np.ndarray) -> np.ndarray:
         """``s_i = sum_j c_ij(|p_ij|^2 + |q_ij|^2)``: (n,)."""
         g = self.graph
-
-        def block(e):
-            I = g.I[e]
-            d = np.take(P, g.J[e], axis=0) - np.take(P, I, axis=0)
-            first = int(I[0])
-            return first, np.bincount(I - first, weights=g.c[e] * np.einsum("ij,ij->i", d, d))
-
         s = self.rest_scale.copy()
         # each block's sums added in block order: a cell whose edges two blocks share gets
         # its two parts in the same order at every thread count
-        for first, part in map_blocks(block, g.edge_blocks()):
+        for first, part in map_blocks(partial(_stretch_block, g, P), g.edge_blocks()):
             s[first:first + part.size] += part
         return s
 
@@ -139,19 +125,35 @@ class RestEdges:
         # minus row i of the covariance matrices with the diagonal's sign flipped, so the same
         # matrices give b (no second 0.2 GB operator at 738k vertices), a block of rows each
         columns = np.ascontiguousarray(Rm.transpose(2, 0, 1))  # (3, n, 3): columns by b
-        n = self.graph.n
-        out = np.empty((n, 3))
-
-        def block(item):
-            rows, matrices = item
-            acc = np.zeros((rows.stop - rows.start, 3))
-            for b, matrix in enumerate(matrices):
-                acc += matrix @ columns[b]
-                acc += (2.0 * self.sum_cq[rows, b])[:, None] * columns[b, rows]
-            out[rows] = 0.5 * acc
-
-        map_blocks(block, self._blocks)
+        out = np.empty((self.graph.n, 3))
+        map_blocks(partial(_divergence_block, columns, self.sum_cq, out), self._blocks)
         return out
+
+
+def _cross_block(P, S, item):
+    """``S[rows]`` from a block's rows of the covariance operators."""
+    rows, matrices = item
+    for b, matrix in enumerate(matrices):
+        S[rows, :, b] = matrix @ P
+
+
+def _stretch_block(g, P, e):
+    """A block ``e`` of edges' weighted squared lengths summed per cell: (its first cell,
+    the sums from there)."""
+    I = g.I[e]
+    d = np.take(P, g.J[e], axis=0) - np.take(P, I, axis=0)
+    first = int(I[0])
+    return first, np.bincount(I - first, weights=g.c[e] * np.einsum("ij,ij->i", d, d))
+
+
+def _divergence_block(columns, sum_cq, out, item):
+    """``out[rows]`` of the rotated divergence from a block's rows of the operators."""
+    rows, matrices = item
+    acc = np.zeros((rows.stop - rows.start, 3))
+    for b, matrix in enumerate(matrices):
+        acc += matrix @ columns[b]
+        acc += (2.0 * sum_cq[rows, b])[:, None] * columns[b, rows]
+    out[rows] = 0.5 * acc
 
 
 def _weighted_lengths(P, I, J, c, e):

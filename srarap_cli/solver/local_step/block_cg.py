@@ -9,6 +9,7 @@ into five passes by blocks of the vector, side by side on the threads of
 added in block order, so the iterates are the same bit for bit at any thread count.
 """
 from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 
@@ -68,26 +69,32 @@ def conjugate_gradients(product: Callable[[np.ndarray, np.ndarray], float],
 
 def _dot(a, b, blocks):
     """``a . b`` as per-block sums added in block order."""
-    return ordered_sum(lambda s: float(a[s] @ b[s]), blocks)
+    return ordered_sum(partial(_dot_block, a, b), blocks)
+
+
+def _dot_block(a, b, s):
+    return float(a[s] @ b[s])
 
 
 def _update(p, z, beta, blocks):
     """``p = z + beta p``; ``p = z`` for ``beta`` None (the first iteration)."""
-    def block(s):
-        if beta is not None:
-            p[s] *= beta
-            p[s] += z[s]
-        else:
-            p[s] = z[s]
+    map_blocks(partial(_update_block, p, z, beta), blocks)
 
-    map_blocks(block, blocks)
+
+def _update_block(p, z, beta, s):
+    if beta is not None:
+        p[s] *= beta
+        p[s] += z[s]
+    else:
+        p[s] = z[s]
 
 
 def _step(x, r, p, q, alpha, blocks):
     """``x += alpha p``, ``r -= alpha q`` in one pass; returns ``r . r``."""
-    def block(s):
-        x[s] += alpha * p[s]
-        r[s] -= alpha * q[s]
-        return float(r[s] @ r[s])
+    return ordered_sum(partial(_step_block, x, r, p, q, alpha), blocks)
 
-    return ordered_sum(block, blocks)
+
+def _step_block(x, r, p, q, alpha, s):
+    x[s] += alpha * p[s]
+    r[s] -= alpha * q[s]
+    return float(r[s] @ r[s])

@@ -184,16 +184,8 @@ class FreeRotorMatrix(spla.LinearOperator):
         """``q = A p`` (flat (4 nf,) arrays) by blocks of rows; returns ``p . q`` (per-block
         sums added in block order): conjugate gradients' product and the dot it feeds, in
         one pass."""
-        X, out = p.reshape(-1, 4), q.reshape(-1, 4)
-
-        def block(item):  # each block's rows whole: the same values at any thread count
-            rows, W = item
-            part = np.einsum("nij,nj->ni", self.D[rows], X[rows])
-            part -= W @ X
-            out[rows] = part
-            return float(np.einsum("ij,ij->", X[rows], part))
-
-        return ordered_sum(block, self._blocks)
+        return ordered_sum(partial(_product_block, self.D, p.reshape(-1, 4), q.reshape(-1, 4)),
+                           self._blocks)
 
     def tocsr(self) -> csr_matrix:
         """The assembled sparse matrix (for the direct fallback)."""
@@ -207,3 +199,13 @@ def _int32(A):
     if A.nnz < np.iinfo(np.int32).max:
         A.indices, A.indptr = A.indices.astype(np.int32), A.indptr.astype(np.int32)
     return A
+
+
+def _product_block(D, X, out, item):
+    """``out[rows] = (A X)[rows]`` for a block of rows (each whole: the same values at any
+    thread count); returns ``X[rows] . out[rows]``."""
+    rows, W = item
+    part = np.einsum("nij,nj->ni", D[rows], X[rows])
+    part -= W @ X
+    out[rows] = part
+    return float(np.einsum("ij,ij->", X[rows], part))
