@@ -122,12 +122,8 @@ class AndersonMixer:
         # the columns are unit vectors: a relative ridge keeps near-dependent ones solvable
         gram[np.diag_indices(k)] += 1e-10
         theta = np.linalg.solve(gram, _products(self._dF[:k], f))
-        dG, out = self._dG[:k], np.empty_like(g)
-
-        def block(cols):  # einsum sums in double without a double copy of the history
-            out[cols] = g[cols] - np.einsum("i,ij->j", theta, dG[:, cols], dtype=float)
-
-        map_blocks(block, blocks(g.size, "values"))
+        out = np.empty_like(g)
+        map_blocks(partial(_mixed_block, g, theta, self._dG[:k], out), blocks(g.size, "values"))
         return out
 
     def _push(self, df, dg):
@@ -154,6 +150,12 @@ def _products(rows, v):
     of columns, their partial sums added in block order (the same at any thread count)."""
     return ordered_sum(partial(_columns_product, rows, v), blocks(v.size, "values"),
                        np.zeros(rows.shape[0]))
+
+
+def _mixed_block(g, theta, dG, out, cols):
+    """``out[cols] = g[cols] - theta . dG[:, cols]`` (einsum sums in double without a
+    double copy of the history)."""
+    out[cols] = g[cols] - np.einsum("i,ij->j", theta, dG[:, cols], dtype=float)
 
 
 def _columns_product(rows, v, cols):
