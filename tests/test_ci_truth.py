@@ -25,6 +25,7 @@ from srarap_cli.runtime.errors import (
     SingularSystemError,
 )
 from srarap_cli.tasks.batch import run as batch
+from srarap_cli.tasks.batch.manifest_job import ManifestJob
 from srarap_cli.tasks.batch.rows import interrupted_row
 from srarap_cli.tasks.deform import job
 from srarap_cli.tasks.job_status import JobStatus
@@ -194,8 +195,7 @@ def test_a_failure_gets_the_same_exit_code_from_deform_and_from_a_batch_row(
     monkeypatch.setattr(job, "deform_mesh", fail)
     r = invoke(["deform", BAR, TWIST, "-o", tmp_path / "o.obj"])
     assert r.exit_code == code and len(error_lines(r.stderr)) == 1, r.stderr
-    row = batch.run_job({"name": "j", "mesh": BAR, "handles": TWIST, "output": "o.obj",
-                         "settings": {}, "expect": None}, str(tmp_path / "b"))
+    row = batch.run_job(ManifestJob("j", BAR, TWIST, "o.obj"), str(tmp_path / "b"))
     assert row.status is JobStatus.FAILED and row.exit_code == code
     # the same text, less what deform adds of the files it had written
     assert error_lines(r.stderr)[0].removeprefix("srarap: error: ").startswith(row.message)
@@ -361,8 +361,8 @@ def test_keyframes_no_frame_reaches_are_said(tmp_path):
 # --- the summary under signals ----------------------------------------------------------------
 
 def test_a_job_committed_before_the_stop_is_reported_done(tmp_path):
-    jobs = [{"name": "j", "mesh": BAR, "handles": TWIST, "output": "o.obj", "settings": {},
-             "expect": None}]
+    jobs = [ManifestJob("j", BAR, TWIST, "o.obj")]
+    import dataclasses
     import time
 
     before = time.time()
@@ -373,7 +373,7 @@ def test_a_job_committed_before_the_stop_is_reported_done(tmp_path):
     # committed by an earlier batch: up to date; no record: interrupted
     assert interrupted_row(jobs[0], str(tmp_path), since=time.time() + 1).status \
         is JobStatus.UP_TO_DATE
-    other = dict(jobs[0], output="p.obj")
+    other = dataclasses.replace(jobs[0], output="p.obj")
     assert interrupted_row(other, str(tmp_path), since=before).status is JobStatus.INTERRUPTED
 
 

@@ -18,6 +18,7 @@ from srarap_cli.solver.multires import MultiresDeformer
 from srarap_cli.solver.oneshot import make_deformer
 from srarap_cli.solver.stop import StopReason
 from srarap_cli.tasks.batch import run as batch
+from srarap_cli.tasks.batch.manifest_job import ManifestJob
 from srarap_cli.tasks.deform import job as job_runner
 
 
@@ -116,7 +117,6 @@ def test_a_batch_job_that_went_non_finite_says_so(bent, tmp_path, monkeypatch):
         raise NumericalError("energy became non-finite at iteration 3")
 
     monkeypatch.setattr(job_runner, "deform_mesh", blow_up)
-    job = {"name": "j", "mesh": str(tmp_path / "m.obj"), "handles": str(tmp_path / "h.yaml"),
-           "output": "o.obj", "settings": {}, "expect": None}
+    job = ManifestJob("j", str(tmp_path / "m.obj"), str(tmp_path / "h.yaml"), "o.obj")
     row = batch.run_job(job, str(tmp_path)).row()
     assert row["status"] == "failed" and row["stop"] == "non-finite"
