@@ -17,6 +17,9 @@ from .solver.settings import Settings as Settings
 from .solver.settings import resolve as resolve
 from .solver.stop import StopReason as StopReason
 from .tasks.api import deform as deform
+from .tasks.batch import BatchJob as BatchJob
+from .tasks.batch import BatchOutcome as BatchOutcome
+from .tasks.batch import run_batch as run_batch
 from .tasks.bench import BenchJob as BenchJob
 from .tasks.bench import run_bench as run_bench
 from .tasks.comparison import CompareJob as CompareJob

@@ -195,6 +195,7 @@ def test_the_python_guide_runs_as_written(tmp_path):
                        capture_output=True, text=True, timeout=300)
     assert p.returncode == 0, p.stderr[-2000:]
     assert (tmp_path / "twisted.obj").exists() and (tmp_path / "turn_180.obj").exists()
+    assert (tmp_path / "suite-out" / "summary.csv").exists()
     assert p.stdout.splitlines()[-1].startswith("True")
 
 
