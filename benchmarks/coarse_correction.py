@@ -20,6 +20,9 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from paired import alternating  # noqa: E402  (after the sys.path entry)
+
 ROOT = os.path.dirname(HERE)
 OUT = os.path.join(ROOT, "out")
 CYLINDER = os.path.join(OUT, "cylinder-1m.obj")
@@ -72,18 +75,8 @@ def main():
                        check=True)
     if args.one or not args.base:
         return one_run(args.mesh, args.handles)
-    tree = os.path.join(OUT, f"base-{args.base}")
-    if not os.path.isdir(tree):
-        subprocess.run(["git", "-C", ROOT, "worktree", "add", "--detach", tree, args.base],
-                       check=True, capture_output=True)
-    runs = {"base": [], "head": []}
-    for _ in range(args.rounds):
-        for name, path in (("base", tree), ("head", ROOT)):
-            done = subprocess.run([sys.executable, __file__, "--one", "--mesh", args.mesh,
-                                   "--handles", args.handles],
-                                  env={**os.environ, "PYTHONPATH": path},
-                                  capture_output=True, text=True, check=True)
-            runs[name].append(json.loads(done.stdout.strip().splitlines()[-1]))
+    runs = alternating(__file__, ["--one", "--mesh", args.mesh, "--handles", args.handles],
+                       args.base, args.rounds)
     print(f"{os.path.basename(args.mesh)}: base {args.base} against the working tree, "
           f"medians of {args.rounds} alternating processes")
     print(f"{'tree':>5} {'iterations':>10} {'corrections':>11} {'correction s':>12} "

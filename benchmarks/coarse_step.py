@@ -37,6 +37,9 @@ from srarap_cli.solver.multires.correction import CoarseCorrection
 from srarap_cli.tasks.pipeline import problem
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from paired import alternating  # noqa: E402  (after the sys.path entry)
+
 OUT = os.path.join(os.path.dirname(HERE), "out")
 CYLINDER = os.path.join(os.path.dirname(HERE), "..", "shared", "meshes", "cylinder.off")
 HANDLES = os.path.join(HERE, "cases", "cylinder-subdivided.yaml")
@@ -110,20 +113,9 @@ def one_round(args, counts):
 
 def paired(args, counts):
     """Base and head in alternating processes; medians per tree and thread count."""
-    root = os.path.dirname(HERE)
-    tree = os.path.join(OUT, f"base-{args.base}")
-    if not os.path.isdir(tree):
-        subprocess.run(["git", "-C", root, "worktree", "add", "--detach", tree, args.base],
-                       check=True, capture_output=True)
-    runs = {"base": [], "head": []}
-    for _ in range(args.rounds):
-        for name, path in (("base", tree), ("head", root)):
-            env = {**os.environ, "PYTHONPATH": path}
-            done = subprocess.run([sys.executable, __file__, "--one", "--levels",
-                                   str(args.levels), "--threads", args.threads, "--steps",
-                                   str(args.steps)], env=env, capture_output=True, text=True,
-                                  check=True)
-            runs[name].append(json.loads(done.stdout.strip().splitlines()[-1]))
+    runs = alternating(__file__, ["--one", "--levels", str(args.levels), "--threads",
+                                  args.threads, "--steps", str(args.steps)],
+                       args.base, args.rounds)
     n = runs["head"][0]["n"]
     print(f"coarse step of {n} vertices, base {args.base} against the working tree, "
           f"medians of {args.rounds} alternating processes of {args.steps} steps "

@@ -26,6 +26,7 @@ from collections.abc import Callable
 from typing import Any
 
 from . import forking
+from .fresh_process import PRELUDE
 
 #: seconds a bounded call may take at least, and per megabyte of its input on top
 #: (``SRARAP_READ_SECONDS`` replaces the first: tests of hostile files use a short one)
@@ -89,18 +90,10 @@ def _fork(func, args, memory):
     return pid, read
 
 
-#: what a fresh child runs: it dies with this process (Linux; the argument is this
-#: process's id), reads the call from its standard input and answers as a forked child does
-_FRESH = """\
-import os, pickle, sys
-try:
-    import ctypes
-    ctypes.CDLL(None).prctl(1, 9, 0, 0, 0)  # PR_SET_PDEATHSIG, SIGKILL
-except Exception:
-    pass
-if os.getppid() != int(sys.argv[1]):
-    sys.exit(1)
-payload = sys.stdin.buffer.read()
+#: what a fresh child runs after the prelude (it dies with this process, reads the call
+#: from its standard input): it answers as a forked child does, on its standard output
+_FRESH = PRELUDE + """\
+import pickle
 from srarap_cli.runtime.bounded import _child
 out = os.dup(1)
 os.dup2(os.open(os.devnull, os.O_WRONLY), 1)

@@ -20,7 +20,7 @@ import sys
 
 #: what the child runs first: it dies with this process (Linux; the argument is this
 #: process's id) and reads its input, so that it never outlives an interrupted run
-_PRELUDE = """\
+PRELUDE = """\
 import os, sys
 try:
     import ctypes
@@ -48,7 +48,7 @@ def run_fresh(source: str, payload: bytes) -> bytes | None:
     True
     """
     try:
-        done = subprocess.run([sys.executable, "-c", _PRELUDE + source, str(os.getpid())],
+        done = subprocess.run([sys.executable, "-c", PRELUDE + source, str(os.getpid())],
                               input=payload, capture_output=True, check=False)
     except (OSError, ValueError, subprocess.SubprocessError):
         return None
