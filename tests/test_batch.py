@@ -214,7 +214,7 @@ def test_a_report_that_cannot_be_written_comes_after_the_summary(tmp_path, monke
     first."""
     from srarap_cli.runtime.errors import OutputError
     from srarap_cli.tasks.batch import BatchJob, run_batch
-    from srarap_cli.tasks.batch import run as batch_run
+    from srarap_cli.tasks.batch import job as batch_job
 
     path = manifest(tmp_path, [{"name": "twist", "mesh": BAR, "handles": TWIST,
                                 "output": "twist.obj"}])
@@ -226,7 +226,7 @@ def test_a_report_that_cannot_be_written_comes_after_the_summary(tmp_path, monke
 
     def full_disk(*args, **kwargs):
         raise OutputError("junit.xml: No space left on device")
-    monkeypatch.setattr(batch_run, "write_reports", full_disk)
+    monkeypatch.setattr(batch_job, "write_reports", full_disk)
     done = run_batch(BatchJob(str(path), str(tmp_path / "out"),
                               junit=str(tmp_path / "junit.xml")))
     assert done.failure is not None and "No space" in str(done.failure)

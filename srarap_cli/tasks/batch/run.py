@@ -1,4 +1,5 @@
-"""Many deformations from one manifest: up-to-date checks, parallel workers, a summary.
+"""The jobs of a manifest, run: up-to-date checks, parallel workers, their rows (the batch
+as one job, with its summary: :mod:`.job`).
 
 A manifest (YAML or JSON) lists jobs; paths are relative to the manifest::
 
@@ -17,144 +18,28 @@ the same fingerprint (content of the mesh, the handle file and every file it nam
 srarap version).
 """
 import contextlib
-import dataclasses
 import functools
 import os
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from contextlib import AbstractContextManager
-from dataclasses import dataclass, field
 from typing import Any
 
 from ...io.handles import load_handles
 from ...io.mesh import read_mesh
-from ...runtime.errors import OutputError
 from ...runtime.parallel import at_most, using_threads, worker_share
-from ...runtime.paths import hold
-from ...runtime.signals import Terminated, block
+from ...runtime.signals import Terminated
 from ..deform import JobResult, run_job_safely
-from ..job_status import Seen, batch_exit_code
+from ..job_status import Seen
 from ..pictures import difference_picture, energy_picture, shape_picture
-from ..preflight import check_output_path
 from ..reports import encode_png
-from .manifest import SUMMARIES, check_goldens, check_outputs, load_manifest
 from .manifest_job import ManifestJob
 from .on_dask import run_on_dask
 from .rows import BatchInterrupted, deform_job, interrupted_row, lost_row, solved_since
-from .summary import write_reports, write_summaries
 from .worker_pool import PoolStopped, run_in_processes
 
+#: what says a long job's stages: a context made from the job's name
 Heartbeat = Callable[[str], AbstractContextManager[Any]]
-
-
-@dataclass(frozen=True)
-class BatchJob:
-    """One run of a manifest, as ``srarap batch`` takes it.
-
-    Attributes
-    ----------
-    manifest : str, the manifest's path (YAML or JSON)
-    out : str, the folder of the jobs' outputs and of ``summary.csv`` / ``summary.json``
-    workers : int, worker processes (1: the jobs run in this process)
-    scheduler : str, optional, ``local`` or a Dask scheduler's address
-    keep_unconverged : bool, write the mesh of a job that did not converge
-    goldens : str, ``check``, ``update`` or ``accept`` (:data:`..deform.golden.GOLDEN_MODES`)
-    threads : int, optional, each job's threads, at most its share of the CPUs
-    settings : mapping, setting values laid over every job's (the command line's
-        ``strict`` and ``allow``)
-    report, junit, markdown, metrics : str, optional, the reports to write too
-    heartbeat : callable(name) -> context, optional, what says a long job's stages (a
-        picklable function: the workers call it)
-    """
-
-    manifest: str
-    out: str = "."
-    workers: int = 1
-    scheduler: str | None = None
-    keep_unconverged: bool = False
-    goldens: str = "check"
-    threads: int | None = None
-    settings: Mapping[str, Any] = field(default_factory=dict)
-    report: str | None = None
-    junit: str | None = None
-    markdown: str | None = None
-    metrics: str | None = None
-    heartbeat: Heartbeat | None = None
-
-
-@dataclass
-class BatchOutcome:
-    """What a batch did: ``rows`` (the jobs' results, in manifest order), ``out`` (the
-    output folder as held), ``stopped`` (the signal's exception that stopped it, else None)
-    and ``failure`` (an error that came after the summary was written: a report that could
-    not be written; the caller raises it once it has said the rows)."""
-
-    rows: list[JobResult]
-    out: str
-    stopped: BaseException | None = None
-    failure: Exception | None = None
-
-    @property
-    def exit_code(self) -> int:
-        """The exit code of a batch that ran to its end (see :func:`batch_exit_code`)."""
-        return batch_exit_code(r.status for r in self.rows)
-
-
-def run_batch(batch: BatchJob) -> BatchOutcome:
-    """Run ``batch``: its checks before any job (the reports' paths, the goldens it may
-    write, outputs that would land on inputs), the jobs (a failing job never stops the
-    others), then ``summary.csv`` / ``summary.json`` and the reports asked for.
-
-    A signal stops the jobs; the outcome says which (``stopped``) and holds the rows of the
-    jobs that finished, the summary written all the same.
-
-    Raises InputError, UsageProblem or OutputError for a run that cannot start.
-    """
-    _check_reports(batch)
-    # over the manifest's defaults and each job's settings, as deform's over a handle file's
-    jobs = [dataclasses.replace(job.over(batch.settings), goldens=batch.goldens)
-            for job in load_manifest(batch.manifest)]
-    if batch.goldens != "check":
-        check_goldens(jobs, batch.manifest)
-    check_outputs(jobs, batch.out, batch.manifest)
-    try:
-        os.makedirs(batch.out, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"{batch.out}: cannot create folder: {exc.strerror}") from None
-    for name in SUMMARIES:  # before solving, as deform checks its -o
-        check_output_path(os.path.join(batch.out, name), None, "summary")
-    held = hold(batch.out)  # every file of the run is written there, whatever -o names later
-    outcome = BatchOutcome([], held)
-    try:
-        outcome.rows = run_jobs(jobs, held, batch.workers, batch.scheduler,
-                                batch.keep_unconverged, pictures=batch.report is not None,
-                                threads=batch.threads, heartbeat=batch.heartbeat)
-    except BatchInterrupted as exc:  # the workers are stopped: say what finished
-        outcome.rows, outcome.stopped = exc.rows, exc.signal
-        # the summary is what is left to do: a second Ctrl-C or SIGTERM (a CI runner's
-        # timeout sends more than one) must not cost it; the exit code says stopped anyway
-        block()
-    # the summary first, on its own: a report that cannot be written (a full disk) must not
-    # cost the account of the jobs whose outputs are on disk
-    write_summaries(outcome.rows, held)
-    try:
-        write_reports(outcome.rows, batch.manifest, batch.report, batch.junit, batch.markdown,
-                      batch.metrics)
-    except OutputError as exc:
-        outcome.failure = exc
-    return outcome
-
-
-def _check_reports(batch):
-    """Refuse, before any job, a report that could not be written."""
-    if batch.report is not None:
-        check_output_path(batch.report, (".html", ".htm"), "--report")
-    if batch.junit is not None:
-        check_output_path(batch.junit, (".xml",), "--junit")
-    for path, what in ((batch.markdown, "--summary-md"), (batch.metrics, "--metrics")):
-        if path is not None:
-            check_output_path(path, None, what)
-
 
 def run_job(job: ManifestJob, out_dir: str, keep_unconverged: bool = False,
             pictures: bool = False, threads: int | None = None,
