@@ -200,6 +200,11 @@ def test_a_batch_is_one_frozen_job_and_one_call_from_python(tmp_path):
     batch = BatchJob(str(path), str(tmp_path / "out"), settings={"strict": True})
     with pytest.raises(dataclasses.FrozenInstanceError):
         batch.workers = 2  # type: ignore[misc]
+    for wrong, error in (({"workers": 0}, ValueError), ({"workers": 2.5}, ValueError),
+                         ({"threads": True}, ValueError), ({"goldens": "sometimes"}, ValueError),
+                         ({"settings": ["strict"]}, TypeError), ({"report": 3}, TypeError)):
+        with pytest.raises(error, match="BatchJob"):
+            BatchJob(str(path), **wrong)
     done = run_batch(batch)
     assert (done.exit_code, done.stopped, done.failure) == (0, None, None)
     assert [(r.job, r.status.value) for r in done.rows] == [("twist", "ok")]

@@ -45,6 +45,16 @@ def number(job: Any, name: str, low: float = 0.0, high: float = math.inf,
                          f"{str(value)[:40]}")
 
 
+def count(job: Any, name: str, optional: bool = False) -> None:
+    """``job.<name>`` is a whole number of at least 1 (or None where ``optional``)."""
+    value = getattr(job, name)
+    if value is None and optional:
+        return
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ValueError(f"{type(job).__name__}.{name} must be a whole number >= 1, got "
+                         f"{str(value)[:40]}")
+
+
 def texts(job: Any, name: str) -> None:
     """``job.<name>`` is a non-empty tuple or list of text."""
     value = getattr(job, name)

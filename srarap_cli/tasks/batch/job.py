@@ -11,6 +11,8 @@ from typing import Any
 from ...runtime.errors import OutputError
 from ...runtime.paths import hold
 from ...runtime.signals import block
+from .. import job_fields as fields
+from ..deform import GOLDEN_MODES
 from ..job_status import JobResult, batch_exit_code
 from ..preflight import check_output_path
 from .manifest import SUMMARIES, check_goldens, check_outputs, load_manifest
@@ -28,18 +30,27 @@ class BatchJob:
 
     Attributes
     ----------
-    manifest : str, the manifest's path (YAML or JSON)
-    out : str, the folder of the jobs' outputs and of ``summary.csv`` / ``summary.json``
-    workers : int, worker processes (1: the jobs run in this process)
-    scheduler : str, optional, ``local`` or a Dask scheduler's address
-    keep_unconverged : bool, write the mesh of a job that did not converge
-    goldens : str, ``check``, ``update`` or ``accept`` (:data:`..deform.golden.GOLDEN_MODES`)
-    threads : int, optional, each job's threads, at most its share of the CPUs
-    settings : mapping, setting values laid over every job's (the command line's
-        ``strict`` and ``allow``)
-    report, junit, markdown, metrics : str, optional, the reports to write too
-    heartbeat : callable(name) -> context, optional, what says a long job's stages (a
-        picklable function: the workers call it)
+    manifest : str
+        The manifest's path (YAML or JSON).
+    out : str
+        The folder of the jobs' outputs and of ``summary.csv`` / ``summary.json``.
+    workers : int
+        Worker processes (1: the jobs run in this process).
+    scheduler : str, optional
+        ``local`` or a Dask scheduler's address.
+    keep_unconverged : bool
+        Write the mesh of a job that did not converge.
+    goldens : str
+        ``check``, ``update`` or ``accept`` (see ``batch --update-goldens``).
+    threads : int, optional
+        Each job's threads, at most its share of the CPUs.
+    settings : mapping
+        Setting values laid over every job's (the command line's ``strict`` and ``allow``).
+    report, junit, markdown, metrics : str, optional
+        The reports to write too: HTML, JUnit XML, Markdown, OpenMetrics.
+    heartbeat : callable, optional
+        ``heartbeat(name)``: a context that says a long job's stages (a picklable
+        function: the workers call it).
     """
 
     manifest: str
@@ -56,13 +67,35 @@ class BatchJob:
     metrics: str | None = None
     heartbeat: Heartbeat | None = None
 
+    def __post_init__(self) -> None:
+        fields.text(self, "manifest")
+        fields.text(self, "out")
+        for name in ("scheduler", "report", "junit", "markdown", "metrics"):
+            fields.text(self, name, optional=True)
+        fields.count(self, "workers")
+        fields.count(self, "threads", optional=True)
+        fields.choice(self, "goldens", GOLDEN_MODES)
+        fields.flag(self, "keep_unconverged")
+        if not isinstance(self.settings, Mapping):
+            raise TypeError("BatchJob.settings must be a mapping of settings")
+
 
 @dataclass
 class BatchOutcome:
-    """What a batch did: ``rows`` (the jobs' results, in manifest order), ``out`` (the
-    output folder as held), ``stopped`` (the signal's exception that stopped it, else None)
-    and ``failure`` (an error that came after the summary was written: a report that could
-    not be written; the caller raises it once it has said the rows)."""
+    """What a batch did.
+
+    Attributes
+    ----------
+    rows : list of JobResult
+        The jobs' results, in manifest order.
+    out : str
+        The output folder, as held for the run (its real path).
+    stopped : BaseException or None
+        The exception of the signal that stopped the batch.
+    failure : Exception or None
+        An error after the summary was written (a report that could not be written); the
+        caller raises it once it has said the rows.
+    """
 
     rows: list[JobResult]
     out: str
