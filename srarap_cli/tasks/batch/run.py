@@ -27,7 +27,7 @@ from typing import Any
 
 from ...io.handles import load_handles
 from ...io.mesh import read_mesh
-from ...runtime.parallel import at_most, using_threads, worker_share
+from ...runtime.parallel import at_most, available_cpus, using_threads, worker_share
 from ...runtime.signals import Terminated
 from ..deform import JobResult, run_job_safely
 from ..job_status import Seen
@@ -55,7 +55,7 @@ def run_job(job: ManifestJob, out_dir: str, keep_unconverged: bool = False,
     job's stages while it runs long (a picklable function: workers call it)."""
     spec = deform_job(job, out_dir, keep_unconverged)
     beat = heartbeat(job.name) if heartbeat is not None else contextlib.nullcontext()
-    with beat, at_most(worker_share(1, threads)), using_threads(threads):
+    with beat, at_most(threads or available_cpus()), using_threads(threads):
         result = run_job_safely(spec)
     if pictures:  # after the seconds: the solve's, not the drawing's
         result.pictures = job_pictures(job, spec.output, result.seen)
