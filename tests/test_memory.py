@@ -10,6 +10,10 @@ pytestmark = pytest.mark.skipif(memory._high_water() is None,
                                 reason="no /proc high-water mark here")
 
 MB = 1 << 20
+# the kernel counts resident pages per CPU and folds them in batches, so VmRSS and VmHWM
+# are each a few pages off (256 KB on 2 cores, more with more cores): far below the 200 MB
+# that a reset mark or an inherited peak would show
+SLACK = 16 * MB
 
 
 # in a fresh process: one whose allocator keeps freed memory resident (the solver's setup
@@ -46,7 +50,7 @@ def test_a_stage_sees_the_memory_it_touched_and_a_later_stage_does_not():
     assert whole >= big  # the enclosing stage keeps the peak of everything inside it
     # nothing reset what the kernel says of the process (/usr/bin/time, ru_maxrss): the
     # process's peak is the largest stage's, as -v says it
-    assert maxrss >= big and hwm == whole
+    assert maxrss >= big - SLACK and abs(hwm - whole) < SLACK
 
 
 def test_closing_an_unmeasured_stage_gives_none_and_formatting_skips_it():

@@ -4,12 +4,14 @@ touching what the kernel reports of the process (``/usr/bin/time``, ``ru_maxrss`
 Linux keeps one high-water mark per process (``VmHWM``), which only grows here: srarap never
 resets it (``/proc/self/clear_refs`` would, and then ``/usr/bin/time`` reported half the peak
 a run needed). A stage during which the mark rose set a new peak of the process, and that
-mark is its peak, exactly; a stage that stayed below an earlier one's is measured by
-sampling the resident size (``VmRSS``) every few milliseconds while it is open, so a short
-spike within it can go unseen (its figure is then a little low, never high). Stages nest (a
-coarse level's setup inside the fine level's): each figure is the highest resident size
-seen between its start and its end, whatever opened or closed inside. Elsewhere (no
-``/proc``) every figure is None.
+mark is its peak; a stage that stayed below an earlier one's is measured by sampling the
+resident size (``VmRSS``) every few milliseconds while it is open, so a short spike within
+it can go unseen (its figure is then a little low). The kernel counts resident pages per
+CPU and folds them in batches, so either figure can be a few pages off (256 KB on 2 cores;
+a ``VmHWM`` read later can sit below a ``VmRSS`` sampled earlier). Stages nest (a coarse
+level's setup inside the fine level's): each figure is the highest resident size seen
+between its start and its end, whatever opened or closed inside. Elsewhere (no ``/proc``)
+every figure is None.
 
 Measuring is off until :func:`enable` (``-v`` turns it on): the sampling thread runs only
 while a stage is open.
