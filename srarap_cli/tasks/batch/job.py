@@ -12,7 +12,7 @@ from ...runtime.errors import OutputError
 from ...runtime.paths import hold
 from ...runtime.signals import block
 from .. import job_fields as fields
-from ..deform import GOLDEN_MODES
+from ..comparison import GOLDEN_MODES
 from ..job_status import JobResult, batch_exit_code
 from ..preflight import check_output_path
 from .manifest import SUMMARIES, check_goldens, check_outputs, load_manifest

@@ -21,7 +21,7 @@ class ManifestJob:
     layers : tuple of mappings, setting values by name: the manifest's ``defaults``, the
         job's own ``settings``, then the command line's options; :attr:`settings` lays them
         one over the other
-    goldens : str, what to do with goldens (see :data:`..deform.golden.GOLDEN_MODES`)
+    goldens : str, what to do with goldens (see :data:`..comparison.goldens.GOLDEN_MODES`)
 
     Examples
     --------

@@ -10,6 +10,7 @@ from .gates import Observed as Observed
 from .gates import judge as judge
 from .gates import parse_expect as parse_expect
 from .gates import verdict_line as verdict_line
+from .goldens import GOLDEN_MODES as GOLDEN_MODES
 from .goldens import read_golden_record as read_golden_record
 from .goldens import record_path as record_path
 from .goldens import refuse_leading_out as refuse_leading_out

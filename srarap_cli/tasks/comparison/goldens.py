@@ -16,6 +16,9 @@ from ...runtime.errors import InputError
 from ...runtime.paths import leads_out
 from .gates import Observed
 
+#: what a run does with a golden that is missing or regressed: nothing (``check``), write it
+#: and still fail (``update``), write it and pass (``accept``)
+GOLDEN_MODES = ("check", "update", "accept")
 #: what ``--update-goldens`` did to a job's golden (the summaries' ``golden`` column)
 CREATED, UPDATED = "created", "updated"
 

@@ -21,7 +21,7 @@ from ..reports import encode_png, junit_xml, report_html
 from .align import moved
 from .compare import ALIGNMENTS, Comparison, Verdict, compare_meshes
 from .gates import Expect, Observed, judge, verdict_line
-from .goldens import write_golden
+from .goldens import GOLDEN_MODES, write_golden
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ class CompareJob:
         fields.number(self, "p95", optional=True)
         fields.number(self, "p99", optional=True)
         fields.choice(self, "align", ALIGNMENTS)
-        fields.choice(self, "goldens", ("check", "update", "accept"))
+        fields.choice(self, "goldens", GOLDEN_MODES)
 
     def expect(self) -> Expect:
         return Expect(self.b, self.tol, self.relative, self.beyond_tol, self.p95, self.p99,

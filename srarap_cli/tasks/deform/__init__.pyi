@@ -4,7 +4,6 @@ from ..job_status import JobResult as JobResult
 from ..job_status import JobStatus as JobStatus
 from .advice import cache_hint as cache_hint
 from .advice import summary_line as summary_line
-from .golden import GOLDEN_MODES as GOLDEN_MODES
 from .golden import check_golden as check_golden
 from .job import DeformJob as DeformJob
 from .job import recorded_result as recorded_result

@@ -18,10 +18,6 @@ from ..comparison import (
 )
 from ..job_status import JobResult, JobStatus
 
-#: what a run does with a golden that is missing or regressed: nothing (``check``), write it
-#: and still fail (``update``), write it and pass (``accept``)
-GOLDEN_MODES = ("check", "update", "accept")
-
 
 def as_expect(expect: Expect | Mapping[str, Any]) -> Expect:
     """``expect`` as an :class:`Expect` (a mapping is parsed as a manifest's is)."""
@@ -35,9 +31,10 @@ def check_golden(result: JobResult, expect: Expect | Mapping[str, Any], out: str
     mesh's diagonal with ``relative``; ``aligned``: the rigid motion applied first), status
     ``regressed`` with every failing gate in the message, or ``no-golden`` when the golden is
     missing; the figures are kept in ``result.seen.golden`` for the report's difference
-    picture. With ``goldens`` ``update`` or ``accept`` (see :data:`GOLDEN_MODES`) a missing
-    or regressed golden is written from ``out`` (never outside ``root``) and
-    ``result.golden`` says so; ``accept`` makes the job pass."""
+    picture. With ``goldens`` ``update`` or ``accept`` (see
+    :data:`..comparison.goldens.GOLDEN_MODES`) a missing or regressed golden is written from
+    ``out`` (never outside ``root``) and ``result.golden`` says so; ``accept`` makes the job
+    pass."""
     expect = as_expect(expect)
     run = Observed(result.iterations, result.energy,
                    result.seconds if result.solved else result.seen.recorded_seconds)

@@ -63,7 +63,7 @@ class DeformJob:
     expect : Expect or mapping, optional, the golden (path) and the gates it must pass (see
         :class:`~srarap_cli.tasks.comparison.gates.Expect`): compare with it
     goldens : {"check", "update", "accept"}, what to do with a missing or regressed golden
-        (see :data:`.golden.GOLDEN_MODES`)
+        (see :data:`..comparison.goldens.GOLDEN_MODES`)
     golden_root : str, optional, the folder goldens may be written in (a batch: the
         manifest's)
     record : bool, keep a record beside the output and take an unchanged job's result from
