@@ -159,3 +159,19 @@ def run_cli(args, cwd=None, input=None):
         return Ran(CliRunner().invoke(main, [str(a) for a in args], input=input))
     finally:
         os.chdir(old)
+
+
+def children(parent=None):
+    """Process ids whose parent is ``parent`` (this process by default; Linux), zombies
+    included."""
+    parent = os.getpid() if parent is None else parent
+    found = set()
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/stat") as fh:
+                fields = fh.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == parent:
+            found.add(int(pid))
+    return found

@@ -106,21 +106,25 @@ def test_a_decompression_bomb_is_refused_before_the_disk_fills(tmp_path):
     assert done.stderr.startswith(f"srarap: error: {bomb}: decompresses to more than 64 MiB")
 
 
-@pytest.mark.parametrize("threads", [1, 2])
-def test_run_bounded_returns_raises_and_bounds(monkeypatch, threads):
-    """Forked where this process runs one thread, a fresh interpreter where it does not
-    (issue 72: one fork policy, runtime.forking); both bound alike."""
+@pytest.mark.parametrize("way", ["fork", "served", "fresh"])
+def test_run_bounded_returns_raises_and_bounds(monkeypatch, way):
+    """Forked where this process runs one thread; where it does not, forked by the child
+    server (runtime.child_server), or a fresh interpreter of its own where no server can run
+    (issue 72: one fork policy, runtime.forking); all bound alike."""
     import operator
 
-    from srarap_cli.runtime import bounded, forking
-    monkeypatch.setattr(forking, "threads", lambda: threads)
+    from srarap_cli.runtime import bounded, child_server, forking
+    monkeypatch.setattr(forking, "threads", lambda: 1 if way == "fork" else 2)
+    if way == "fresh":
+        monkeypatch.setattr(child_server, "available", lambda: False)
     started = []
-    for way in ("_fork", "_fresh"):
-        real = getattr(bounded, way)
-        monkeypatch.setattr(bounded, way, lambda *a, real=real, way=way: (started.append(way),
-                                                                         real(*a))[1])
+    for module, name, said in ((bounded, "_fork", "fork"), (bounded, "_fresh", "fresh"),
+                               (child_server, "_ask", "served")):
+        real = getattr(module, name)
+        monkeypatch.setattr(module, name, lambda *a, real=real, said=said: (started.append(said),
+                                                                           real(*a))[1])
     assert run_bounded(np.arange, 5, seconds=10, memory=None).tolist() == [0, 1, 2, 3, 4]
-    assert started == ["_fork" if threads == 1 else "_fresh"]
+    assert started == [way]
     with pytest.raises(ZeroDivisionError):
         run_bounded(operator.truediv, 1, 0, seconds=10, memory=None)
     with pytest.raises(OutOfTime):
@@ -128,7 +132,7 @@ def test_run_bounded_returns_raises_and_bounds(monkeypatch, threads):
     with pytest.raises(OutOfMemory):
         run_bounded(np.ones, 10 ** 10, seconds=30, memory=200 << 20)
     assert time_bound(10 ** 6) > time_bound(0) > 0
-    assert len(set(started)) == 1
+    assert set(started) == {way}
 
 
 def test_the_fork_policy_is_one_table(monkeypatch):

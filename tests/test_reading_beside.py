@@ -8,35 +8,21 @@ import time
 
 import numpy as np
 import pytest
-from helpers import ROOT, tube
+from helpers import ROOT, children, tube
 
 from srarap_cli.io.mesh import Mesh, read_mesh, reading_beside, write_mesh
+from srarap_cli.runtime import child_server, forking
 from srarap_cli.runtime.bounded import start_bounded
 from srarap_cli.runtime.errors import InputError
 
 SPOT = os.path.join(ROOT, "sample_meshes", "spot.obj")
 
 
-def _children():
-    """Process ids of this process's children (Linux), zombies included."""
-    me = str(os.getpid())
-    found = set()
-    for pid in filter(str.isdigit, os.listdir("/proc")):
-        try:
-            with open(f"/proc/{pid}/stat") as fh:
-                fields = fh.read().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if fields[1] == me:
-            found.add(int(pid))
-    return found
-
-
 def test_the_mesh_read_beside_is_the_mesh_read_here(tmp_path):
     V, F = tube(length=2.0, rings=8, segments=10)
     other = str(tmp_path / "tube.ply")
     write_mesh(other, Mesh.from_arrays(V, F))
-    before = _children()
+    before = children()
     with reading_beside(SPOT) as rest:
         here = read_mesh(other)
         beside = rest()
@@ -45,7 +31,7 @@ def test_the_mesh_read_beside_is_the_mesh_read_here(tmp_path):
     assert np.array_equal(beside.face_vertices, spot.face_vertices)
     assert np.array_equal(beside.normals, spot.normals) and beside.statements == spot.statements
     assert np.array_equal(here.vertices, V)
-    assert _children() <= before  # nothing left running, no zombie
+    assert children() <= before  # nothing left running, no zombie
 
 
 def test_an_error_beside_is_the_error_here(tmp_path):
@@ -61,12 +47,22 @@ def test_an_error_beside_is_the_error_here(tmp_path):
         assert rest() is None
 
 
-def test_leaving_early_stops_the_child():
+@pytest.mark.parametrize("threads", [1, 2])
+def test_leaving_early_stops_the_child(monkeypatch, threads):
+    """Forked here (one thread) or by the child server (other threads run)."""
+    monkeypatch.setattr(forking, "threads", lambda: threads)
+    before = children()  # the child server among them, where an earlier test started it
     with pytest.raises(RuntimeError, match="the shown mesh failed"):
         with start_bounded(time.sleep, 30, seconds=60, memory=None) as call:
-            assert call.pid in _children()
+            parent = os.getpid() if threads == 1 else child_server._server[0].pid
+            running = children(parent) - before
+            assert len(running) == 1 and (call.pid in running or threads > 1)
             raise RuntimeError("the shown mesh failed")
-    assert call.pid not in _children()  # killed and reaped: no zombie
+    # killed and reaped (by its parent: the server reaps within half a second)
+    end = time.monotonic() + 10
+    while children(parent) & running and time.monotonic() < end:
+        time.sleep(0.02)
+    assert not children(parent) & running
 
 
 def test_with_other_threads_the_read_runs_here(monkeypatch):

@@ -10,10 +10,11 @@ bound, the hang ends with the child (SIGKILL, which nothing ignores) while srara
 instead of taking the machine's memory.
 
 The child is forked (the reader's modules are loaded already: no start-up cost) where this
-process runs a single thread, else a fresh interpreter (see :mod:`.forking`: a fork beside
-other threads can copy a lock one of them holds), and sends its result back pickled through
-a pipe; without ``os.fork`` (or with ``SRARAP_BOUNDED=0``) the call runs in this process,
-unbounded.
+process runs a single thread, else forked by a fresh interpreter kept for it (see
+:mod:`.forking`: a fork beside other threads can copy a lock one of them holds; and
+:mod:`.child_server`), or, where that server cannot run, it is a fresh interpreter of its
+own; it sends its result back pickled through a pipe. Without ``os.fork`` (or with
+``SRARAP_BOUNDED=0``) the call runs in this process, unbounded.
 """
 import os
 import pickle
@@ -23,9 +24,11 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
-from . import forking
+from . import child_server, forking
+from .child_call import run_child
 from .fresh_process import PRELUDE
 
 #: seconds a bounded call may take at least, and per megabyte of its input on top
@@ -75,9 +78,13 @@ def start_bounded(func: Callable[..., Any], *args: Any, seconds: float,
     way = forking.how(need)
     if way == "here":
         return Pending(lambda: func(*args))
-    start = _fork if way == "fork" else _fresh
-    pid, read = start(func, args, memory)
-    return Pending(None, (pid, read, time.monotonic() + seconds, seconds))
+    end = time.monotonic() + seconds
+    served = child_server.start(func, args, memory) if way == "fresh" else None
+    if served is not None:
+        pidfd, read = served
+        return Pending(None, (None, read, end, seconds, partial(child_server.reap, pidfd)))
+    pid, read = (_fork if way == "fork" else _fresh)(func, args, memory)
+    return Pending(None, (pid, read, end, seconds, partial(_reap, pid)))
 
 
 def _fork(func, args, memory):
@@ -85,7 +92,7 @@ def _fork(func, args, memory):
     pid = os.fork()
     if pid == 0:  # the child: never returns
         os.close(read)
-        _child(write, func, args, memory)
+        run_child(write, func, args, memory)
     os.close(write)
     return pid, read
 
@@ -94,10 +101,10 @@ def _fork(func, args, memory):
 #: from its standard input): it answers as a forked child does, on its standard output
 _FRESH = PRELUDE + """\
 import pickle
-from srarap_cli.runtime.bounded import _child
+from srarap_cli.runtime.child_call import run_child
 out = os.dup(1)
 os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
-_child(out, *pickle.loads(payload))
+run_child(out, *pickle.loads(payload))
 """
 
 
@@ -150,23 +157,25 @@ class Pending:
     """A call of :func:`start_bounded`: in a child process, or to run here."""
 
     def __init__(self, here: Callable[[], Any] | None,
-                 child: tuple[int, int, float, float] | None = None) -> None:
+                 child: tuple[int | None, int, float, float, Callable[[bool], None]]
+                 | None = None) -> None:
         self._here, self._child = here, child
-        #: the child's process id (None: the call runs here)
+        #: the child's process id, where it is this process's child (None: the call runs
+        #: here, or in a child of the :mod:`.child_server`)
         self.pid = None if child is None else child[0]
 
     def result(self) -> Any:
         """The call's result, or its exception raised here (see :func:`run_bounded`)."""
         if self._child is None:
             return self._here() if self._here is not None else None
-        pid, read, end, seconds = self._child
+        _, read, end, seconds, reap = self._child
         self._child = None
         data = None
         try:
             data = _collect(read, end, seconds)
         finally:
             os.close(read)
-            _reap(pid, kill=data is None)
+            reap(data is None)
         return _decoded(data)
 
     def __enter__(self) -> "Pending":
@@ -174,10 +183,10 @@ class Pending:
 
     def __exit__(self, *exc: object) -> None:
         if self._child is not None:  # left without its result: the child goes too
-            pid, read, _, _ = self._child
+            _, read, _, _, reap = self._child
             self._child = None
             os.close(read)
-            _reap(pid, kill=True)
+            reap(True)
 
 
 def _decoded(data: bytes | None) -> Any:
@@ -189,52 +198,6 @@ def _decoded(data: bytes | None) -> Any:
     if kind == "error" and isinstance(value, BaseException):
         raise value
     raise OutOfMemory("the reading process ended without a result (killed for memory?)")
-
-
-def _child(write: int, func: Callable[..., Any], args: tuple, memory: int | None) -> None:
-    code = 0
-    try:
-        for signum in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(signum, signal.SIG_DFL)
-        _limit_memory(memory)
-        try:
-            out = ("ok", func(*args))
-        except MemoryError as exc:
-            out = ("memory", str(exc))
-        except Exception as exc:  # noqa: BLE001 -- carried to the parent, raised there
-            out = ("error", exc)
-        try:
-            data = pickle.dumps(out, protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception as exc:  # noqa: BLE001 -- an exception that does not pickle
-            data = pickle.dumps(("error", RuntimeError(f"{type(exc).__name__}: {exc}")))
-        with os.fdopen(write, "wb") as out_file:
-            out_file.write(data)
-    except BaseException:  # noqa: BLE001 -- the child ends here whatever happened
-        code = 1
-    finally:
-        os._exit(code)
-
-
-def _limit_memory(memory: int | None) -> None:
-    if memory is None:
-        return
-    import resource
-
-    now = _address_space_used()
-    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
-    want = now + memory
-    if hard != resource.RLIM_INFINITY:
-        want = min(want, hard)
-    if soft == resource.RLIM_INFINITY or want < soft:
-        resource.setrlimit(resource.RLIMIT_AS, (want, hard))
-
-
-def _address_space_used() -> int:
-    try:
-        with open("/proc/self/statm") as fh:
-            return int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
-    except (OSError, ValueError, IndexError):
-        return 0
 
 
 def _collect(read: int, end: float, seconds: float) -> bytes:

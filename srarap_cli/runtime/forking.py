@@ -20,8 +20,9 @@ need          for                                                  alone   other
 ``workers``   a batch's worker processes                           fork    fresh
 ============  ===================================================  ======  =========
 
-``fresh`` is a new interpreter (for workers, a fork server started fresh, which forks
-them). ``SRARAP_BOUNDED=0`` (or a platform without ``os.fork``) runs ``bound`` and
+``fresh`` is a new interpreter: for workers, a fork server started fresh, which forks
+them; for ``bound`` work, the child server (:mod:`.child_server`), one kept for the
+process, which forks each call. ``SRARAP_BOUNDED=0`` (or a platform without ``os.fork``) runs ``bound`` and
 ``beside`` work here, unbounded.
 """
 import os

@@ -1,0 +1,56 @@
+"""What a bounded child runs (:mod:`.bounded`; forked here, by :mod:`.child_server`, or
+a fresh interpreter): the call under its memory bound, its answer pickled to its parent."""
+import os
+import pickle
+import signal
+from collections.abc import Callable
+from typing import Any
+
+
+def run_child(write: int, func: Callable[..., Any], args: tuple, memory: int | None) -> None:
+    """In the child: ``func(*args)`` with ``memory`` bytes of address space beyond what the
+    child holds now (None: no bound), its result or exception pickled to the descriptor
+    ``write``; then the child ends (this never returns)."""
+    code = 0
+    try:
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(signum, signal.SIG_DFL)
+        _limit_memory(memory)
+        try:
+            out = ("ok", func(*args))
+        except MemoryError as exc:
+            out = ("memory", str(exc))
+        except Exception as exc:  # noqa: BLE001 -- carried to the parent, raised there
+            out = ("error", exc)
+        try:
+            data = pickle.dumps(out, protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception as exc:  # noqa: BLE001 -- an exception that does not pickle
+            data = pickle.dumps(("error", RuntimeError(f"{type(exc).__name__}: {exc}")))
+        with os.fdopen(write, "wb") as out_file:
+            out_file.write(data)
+    except BaseException:  # noqa: BLE001 -- the child ends here whatever happened
+        code = 1
+    finally:
+        os._exit(code)
+
+
+def _limit_memory(memory: int | None) -> None:
+    if memory is None:
+        return
+    import resource
+
+    now = _address_space_used()
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    want = now + memory
+    if hard != resource.RLIM_INFINITY:
+        want = min(want, hard)
+    if soft == resource.RLIM_INFINITY or want < soft:
+        resource.setrlimit(resource.RLIMIT_AS, (want, hard))
+
+
+def _address_space_used() -> int:
+    try:
+        with open("/proc/self/statm") as fh:
+            return int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
