@@ -23,7 +23,7 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import partial
 from typing import Any
 
@@ -57,17 +57,21 @@ def time_bound(size_bytes: int) -> float:
 
 
 def run_bounded(func: Callable[..., Any], *args: Any, seconds: float,
-                memory: int | None) -> Any:
+                memory: int | None, preload: Sequence[str] = ()) -> Any:
     """``func(*args)`` in a child process given ``seconds`` and ``memory`` bytes of address
     space beyond what it starts with (None: no memory bound). Returns its result or raises
     its exception (both pickled back); raises :class:`OutOfTime` or :class:`OutOfMemory`
-    past a bound. A signal that ends this process kills the child first."""
-    with start_bounded(func, *args, seconds=seconds, memory=memory) as call:
+    past a bound. A signal that ends this process kills the child first. ``preload``: the
+    modules ``func`` imports, imported once by whatever forks the child (this process or
+    the child server) rather than by every child."""
+    with start_bounded(func, *args, seconds=seconds, memory=memory,
+                       preload=preload) as call:
         return call.result()
 
 
 def start_bounded(func: Callable[..., Any], *args: Any, seconds: float,
-                  memory: int | None, need: str = "bound") -> "Pending":
+                  memory: int | None, need: str = "bound",
+                  preload: Sequence[str] = ()) -> "Pending":
     """:func:`run_bounded` started, not waited for: this process goes on (reads another
     file, say) while the child works; :meth:`Pending.result` waits. Use it in a ``with``
     block: leaving the block without the result (an error, a signal) kills the child.
@@ -79,10 +83,12 @@ def start_bounded(func: Callable[..., Any], *args: Any, seconds: float,
     if way == "here":
         return Pending(lambda: func(*args))
     end = time.monotonic() + seconds
-    served = child_server.start(func, args, memory) if way == "fresh" else None
+    served = child_server.start(func, args, memory, preload) if way == "fresh" else None
     if served is not None:
         pidfd, read = served
         return Pending(None, (None, read, end, seconds, partial(child_server.reap, pidfd)))
+    if way == "fork":
+        child_server.imported(preload)
     pid, read = (_fork if way == "fork" else _fresh)(func, args, memory)
     return Pending(None, (pid, read, end, seconds, partial(_reap, pid)))
 

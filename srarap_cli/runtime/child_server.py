@@ -14,6 +14,7 @@ and kills the children still running first; a child dies with the server. A serv
 died is started again at the next call. Where there is no pidfd, or the server cannot start,
 :func:`start` returns None and the caller starts a fresh interpreter for the call.
 """
+import importlib
 import os
 import pickle
 import select
@@ -23,7 +24,7 @@ import struct
 import subprocess
 import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from .child_call import run_child
@@ -47,12 +48,15 @@ def available() -> bool:
         (os, "pidfd_open"), (signal, "pidfd_send_signal"), (socket, "send_fds")))
 
 
-def start(func: Callable[..., Any], args: tuple, memory: int | None) -> tuple[int, int] | None:
-    """``func(*args)`` under :func:`.child_call.run_child` in a child the server forks: its pidfd
-    and the reading end of its result's pipe, or None where no server can run here."""
+def start(func: Callable[..., Any], args: tuple, memory: int | None,
+          preload: Sequence[str] = ()) -> tuple[int, int] | None:
+    """``func(*args)`` under :func:`.child_call.run_child` in a child the server forks, once
+    the server has imported the modules ``preload`` names: the child's pidfd and the
+    reading end of its result's pipe, or None where no server can run here."""
     if not available():
         return None
-    payload = pickle.dumps((func, args, memory), protocol=pickle.HIGHEST_PROTOCOL)
+    payload = pickle.dumps((tuple(preload), func, args, memory),
+                           protocol=pickle.HIGHEST_PROTOCOL)
     read, write = os.pipe()
     try:
         with _lock:
@@ -177,7 +181,8 @@ def _receive(sock: socket.socket) -> tuple[bytes, int] | None:
 
 def _fork_child(sock: socket.socket, payload: bytes, write: int) -> int:
     try:  # here, not in the child: what it imports, later children start with
-        func, args, memory = pickle.loads(payload)
+        preload, func, args, memory = pickle.loads(payload)
+        imported(preload)
     except Exception as exc:  # noqa: BLE001 -- the child raises it to the caller
         func, args, memory = _raise, (exc,), None
     pid = os.fork()
@@ -187,6 +192,16 @@ def _fork_child(sock: socket.socket, payload: bytes, write: int) -> int:
         run_child(write, func, args, memory)
     os.close(write)
     return pid
+
+
+def imported(modules: Sequence[str]) -> None:
+    """Import ``modules`` here, so that a child forked later starts with them (one that
+    fails to import is left to the child, whose error then says why)."""
+    for name in modules:
+        try:
+            importlib.import_module(name)
+        except Exception:  # noqa: BLE001 -- the child meets it again and reports it
+            continue
 
 
 def _raise(exc: BaseException) -> None:

@@ -159,7 +159,7 @@ def _reader(name, spec):
         seconds = time_bound(os.path.getsize(path))
         try:
             return run_bounded(_read, name, spec, path, seconds=seconds,
-                               memory=available_memory())
+                               memory=available_memory(), preload=("meshio",))
         except OutOfTime:
             raise InputError(f"{path}: meshio's {spec.display} reader did not finish in "
                              f"{seconds:.0f} s; stopped (a truncated or damaged file?)") from None
