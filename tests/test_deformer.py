@@ -49,7 +49,10 @@ def test_rigid_motion_of_all_handles_is_reproduced_exactly(bar):
     V, F, ids = bar
     Rm = to_matrix(from_axis_angle([1, 1, 0.3], 170))
     t = np.array([2.0, -1.0, 3.0])
-    r = deform(V, F, ids, V[ids] @ Rm.T + t, max_iter=3000, tol=1e-12)
+    # exact from the first iteration; at this tol the stop test meets the rotors' rounding
+    # (a bending energy of about 1e-14 against 1.5e-16 taken for exact) and never fires, so
+    # the budget ends the solve: every iterate must stay exact
+    r = deform(V, F, ids, V[ids] @ Rm.T + t, max_iter=50, tol=1e-12)
     assert np.abs(r.positions - (V @ Rm.T + t)).max() < 1e-8
     scale = np.sum((V[F[:, 1]] - V[F[:, 0]]) ** 2)
     assert r.log[-1]["membrane"] < 1e-12 * scale
