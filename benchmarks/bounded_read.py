@@ -6,7 +6,7 @@ pidfds), in the same run, alternating; with the read in this process, unbounded,
 floor. Medians of ``--repeat`` reads of the sample bar written as VTU; the first served read
 (it starts the server) is reported apart.
 
-Run: python benchmarks/bounded_read.py [--repeat 15] [--format vtu]
+Run: python benchmarks/bounded_read.py [--repeat 15] [--ext vtu]
 """
 import argparse
 import os
@@ -31,7 +31,7 @@ def timed(path):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=15)
-    parser.add_argument("--format", default="vtu")
+    parser.add_argument("--ext", default="vtu", help="the file's extension (a meshio format)")
     args = parser.parse_args()
     done = threading.Event()
     beside = threading.Thread(target=done.wait)  # this process now runs other threads
@@ -39,7 +39,7 @@ def main():
     served_available = child_server.available
     try:
         with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, f"bar.{args.format}")
+            path = os.path.join(folder, f"bar.{args.ext}")
             write_mesh(path, read_mesh(BAR))
             first = timed(path)
             times = {"served": [], "fresh": [], "here": []}
@@ -56,7 +56,7 @@ def main():
         done.set()
         beside.join()
     median = {way: statistics.median(t) for way, t in times.items()}
-    print(f"{args.format} read of the bar beside a thread, medians of {args.repeat}:")
+    print(f"{args.ext} read of the bar beside a thread, medians of {args.repeat}:")
     print(f"  in this process, unbounded:        {median['here'] * 1e3:8.1f} ms")
     print(f"  forked by the child server:        {median['served'] * 1e3:8.1f} ms"
           f"  (the first, starting it: {first * 1e3:.0f} ms)")
