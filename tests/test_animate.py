@@ -67,7 +67,7 @@ def test_rigid_keyframed_motion_of_every_handle_gives_rigid_frames(rings, multir
                       for g, box in (("base", BASE["box"]), ("top", TOP_BOX))}}
     c = parse_handles(doc, mesh.vertices)
     frames = []
-    # exact from the first iteration; the budget ends each frame (see test_deformer's rigid test)
+    # exact from the first iteration, and each frame stops when nothing moves any more
     animator = Animator(mesh, c, resolve({"multires": multires, "max_iter": 50, "tol": 1e-13}))
     assert (multires == "off") == (animator.deformer.__class__.__name__ == "Deformer")
     animator.run(4, on_frame=lambda f, P, s: frames.append(P))

@@ -3,17 +3,19 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from srarap_cli.solver.drivers.monitor import EXACT, WINDOW, Monitor
+from srarap_cli.solver.drivers.monitor import EXACT, STILL, WINDOW, Monitor
 
 
 def run(energies, *, tol=1e-6, moves=None, energy_scale=1.0):
-    """Record one state per energy (the first is the start); the iteration it stopped at."""
+    """Record one state per energy (the first is the start), each step moving a vertex by
+    ``moves[k]`` (default 1e-4 of the mesh's size: still moving, within sqrt(tol)); the
+    iteration it stopped at."""
     m = Monitor(max_iter=len(energies) + 5, tol=tol, energy_scale=energy_scale, scale=1.0)
-    moves = moves or [0.0] * len(energies)
+    moves = moves or [1e-4] * len(energies)
     previous = None
-    for k, (e, move) in enumerate(zip(energies, moves)):
+    for k, (e, x) in enumerate(zip(energies, np.cumsum(moves))):
         state = SimpleNamespace(total=e, membrane=e, bending=0.0,
-                                positions=np.array([[move * k, 0.0, 0.0]]))
+                                positions=np.array([[x, 0.0, 0.0]]))
         if m.record(state, previous):
             return k, m.converged
         previous = state
@@ -52,6 +54,20 @@ def test_an_exact_answer_stops_even_though_its_relative_changes_are_noise():
     assert 1e-14 < 1e-6 * EXACT  # below the default tol's exact-answer level
     # a tight tol asks for more than that: the same energies do not count as exact then
     assert run([1.0] + tiny, tol=1e-16, energy_scale=1.0) == (None, False)
+
+
+def test_an_iterate_that_no_longer_moves_is_converged_whatever_its_energy_noise():
+    """An exactly rigid answer keeps a bending energy of rounding (the rotors' errors),
+    which may sit above a tight tol's exact level: a solve whose last WINDOW steps moved
+    nothing beyond rounding stops, converged; fewer such steps do not; tol 0 is a budget."""
+    tiny = [2e-14, 1e-14, 3e-14, 1.5e-14]
+    still = [0.0] + [STILL / 2] * len(tiny)
+    assert run([1.0] + tiny, tol=1e-16, moves=still) == (WINDOW, True)
+    assert run([1.0] + tiny, tol=1e-16, moves=[0.0, 1e-4, STILL / 2, STILL / 2, 1e-4]) \
+        == (None, False)
+    assert run([1.0] + tiny, tol=1e-16, moves=[0.0] + [2 * STILL] * len(tiny)) \
+        == (None, False)
+    assert run([1.0] + tiny, tol=0.0, moves=still) == (None, False)
 
 
 def test_a_large_move_keeps_the_run_going_however_little_the_energy_changed():

@@ -150,7 +150,8 @@ SETTINGS = (
     Setting("tol", "float", 1e-6,
             "Stop when the relative energy change, averaged over the last 3 steps, is at most "
             "this (and the last step moved no vertex by more than sqrt(tol) of the "
-            "bounding-box diagonal).", "solve", minimum=0),
+            "bounding-box diagonal), or when 3 steps in a row moved no vertex beyond "
+            "rounding; 0 runs max_iter steps.", "solve", minimum=0),
     Setting("time_limit", "float", None,
             "Stop (not converged) once the solve has run this many seconds.", "solve",
             minimum=0, strict=True, metavar="SECONDS"),

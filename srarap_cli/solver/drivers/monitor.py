@@ -13,6 +13,14 @@ An energy below ``tol * EXACT`` times the rest shape's scale ``sum c
 |q|^2`` is converged at once: the minimum is not below zero, so at most that much is left to
 gain (vertices within about ``sqrt(tol * EXACT)`` of the edge lengths of the answer), while the
 relative changes of an energy near rounding level are noise that may never settle.
+That energy has a floor, though: the rotors come out of their solves with errors of about
+1e-9, so an exactly rigid answer keeps a bending energy of 1e-17 (a 106-vertex tube) to 1e-14
+(Spot) of the scale, more on larger meshes, above ``tol * EXACT`` for a tol below about 1e-8;
+such a solve never stopped (a rigid motion asked to tol 1e-12 ran its 1000 iterations, exact
+from the first). So a solve whose last WINDOW steps each moved no vertex by more than
+:data:`STILL` of the mesh's size is converged too: its iterate no longer changes at the
+arithmetic's precision, and further steps only stir the rounding. A tol of 0 (a fixed
+budget) runs its budget.
 """
 import time
 from collections.abc import Callable
@@ -30,16 +38,20 @@ WINDOW = 3
 EXACT = 1e-6
 #: relative changes divide by at least this much of the rest shape's scale
 FLOOR = 1e-14
+#: steps that move no vertex by more than this much of the mesh's size leave it as it is, to
+#: the arithmetic's precision (64 units of double rounding)
+STILL = 64 * float(np.finfo(float).eps)
 
 
-def recent_changes(log: list[dict[str, Any]]) -> list[float]:
-    """Relative energy changes of the last WINDOW steps of ``log`` after its latest start row
-    (``step`` ending in ``start``), oldest first; what the energy test averages."""
+def recent_changes(log: list[dict[str, Any]], key: str = "rel_change") -> list[float]:
+    """Relative energy changes (or another column, ``key``) of the last WINDOW steps of
+    ``log`` after its latest start row (``step`` ending in ``start``), oldest first; what the
+    energy test averages."""
     changes: list[float] = []
     for row in reversed(log):
         if row["step"].endswith("start") or len(changes) == WINDOW:
             break
-        changes.append(row["rel_change"])
+        changes.append(row[key])
     return changes[::-1]
 
 
@@ -52,7 +64,9 @@ class Monitor:
     tol : float, converged when the relative energy changes ``|E_k - E_{k-1}| / |E_{k-1}|``
         of the last WINDOW steps average at most ``tol`` and the last step moved no vertex by
         more than ``sqrt(tol) * scale`` (an accelerated step can change the shape a lot while
-        the energy barely changes); or when the energy is below ``tol * EXACT * energy_scale``
+        the energy barely changes); or when the energy is below ``tol * EXACT * energy_scale``;
+        or (tol above 0) when the last WINDOW steps each moved no vertex by more than
+        ``STILL * scale``
     time_limit : float or None, stop (not converged) after this many seconds
     callback : callable(dict) or None, called with each log row
     energy_scale : float, the rest shape's ``sum c |q|^2``; relative changes divide by at
@@ -74,6 +88,7 @@ class Monitor:
                  scale: float = float("inf")) -> None:
         self.max_iter, self.tol, self.time_limit = max_iter, tol, time_limit
         self.move_tol = np.sqrt(max(tol, 0.0)) * scale
+        self.still_tol = STILL * scale if tol > 0 and np.isfinite(scale) else -1.0
         self.callback = callback
         self.energy_floor = FLOOR * energy_scale
         self.exact_energy = max(tol, 0.0) * EXACT * energy_scale
@@ -123,6 +138,9 @@ class Monitor:
             settled = len(changes) == WINDOW and sum(changes) <= WINDOW * self.tol
             exact = abs(self.log[-1]["total"]) < self.exact_energy
             if (settled or exact) and move <= self.move_tol:
+                return StopReason.CONVERGED
+            moves = recent_changes(self.log, "max_move")
+            if len(moves) == WINDOW and max(moves) <= self.still_tol:
                 return StopReason.CONVERGED
         if self.iterations >= self.max_iter:
             reason = StopReason.ITERATIONS_RUN if self.tol == 0 else StopReason.ITERATION_LIMIT
