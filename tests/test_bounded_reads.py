@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 import pytest
-from helpers import ROOT
+from helpers import ROOT, children
 
 from srarap_cli.io.mesh import FORMATS, Mesh, read_mesh, write_mesh
 from srarap_cli.io.mesh.meshio_formats import TABLE
@@ -86,7 +86,10 @@ def test_a_signal_during_a_read_that_loops_ends_srarap_and_the_reader(tmp_path, 
     p = subprocess.Popen([sys.executable, "-m", "srarap_cli", "info", str(bad)],
                          stderr=subprocess.PIPE, text=True,
                          env={**os.environ, "SRARAP_READ_SECONDS": "300"})
-    time.sleep(3)  # inside the reader's loop by now
+    end = time.monotonic() + 120  # the read started: its child is there (a fixed wait was
+    while not children(p.pid) and time.monotonic() < end:  # 3 s, short on a busy machine)
+        time.sleep(0.02)
+    assert children(p.pid), "the reader never started"
     p.send_signal(signum)
     err = p.communicate(timeout=60)[1]
     assert p.returncode == code and err.count("\n") == 1 and "srarap: error: " in err, err
