@@ -14,6 +14,7 @@ and kills the children still running first; a child dies with the server. A serv
 died is started again at the next call. Where there is no pidfd, or the server cannot start,
 :func:`start` returns None and the caller starts a fresh interpreter for the call.
 """
+import functools
 import importlib
 import os
 import pickle
@@ -42,10 +43,18 @@ _lock = threading.Lock()
 _server: tuple[subprocess.Popen, socket.socket] | None = None
 
 
+@functools.cache
 def available() -> bool:
-    """Whether this platform has what the server needs (pidfds, descriptor passing)."""
-    return all(hasattr(module, name) for module, name in (
-        (os, "pidfd_open"), (signal, "pidfd_send_signal"), (socket, "send_fds")))
+    """Whether this platform has what the server needs: pidfds (Linux 5.3; a container's
+    seccomp filter may refuse them, so one is opened to see) and descriptor passing."""
+    if not all(hasattr(module, name) for module, name in (
+            (os, "pidfd_open"), (signal, "pidfd_send_signal"), (socket, "send_fds"))):
+        return False
+    try:
+        os.close(os.pidfd_open(os.getpid()))
+    except OSError:
+        return False
+    return True
 
 
 def start(func: Callable[..., Any], args: tuple, memory: int | None,
