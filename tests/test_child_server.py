@@ -96,3 +96,17 @@ def test_the_server_and_its_children_end_with_their_process(signum):
     finally:
         owner.kill()
         owner.wait()
+
+
+def test_a_server_that_cannot_start_is_not_tried_again_and_calls_run_fresh(beside_threads,
+                                                                           monkeypatch):
+    monkeypatch.setattr(child_server, "_SERVER", "raise SystemExit(1)")
+    monkeypatch.setattr(child_server, "_server", None)
+    monkeypatch.setattr(child_server, "_failed", False)
+    asks = []
+    real = child_server._ask
+    monkeypatch.setattr(child_server, "_ask", lambda *a: (asks.append(a), real(*a))[1])
+    assert run_bounded(abs, -2, seconds=30, memory=None) == 2
+    assert len(asks) == 2 and child_server._failed
+    assert run_bounded(abs, -3, seconds=30, memory=None) == 3
+    assert len(asks) == 2

@@ -18,7 +18,6 @@ own; it sends its result back pickled through a pipe. Without ``os.fork`` (or wi
 """
 import os
 import pickle
-import select
 import signal
 import subprocess
 import sys
@@ -28,7 +27,7 @@ from functools import partial
 from typing import Any
 
 from . import child_server, forking
-from .child_call import run_child
+from .child_call import readable, run_child
 from .fresh_process import PRELUDE
 
 #: seconds a bounded call may take at least, and per megabyte of its input on top
@@ -214,8 +213,7 @@ def _collect(read: int, end: float, seconds: float) -> bytes:
         left = end - time.monotonic()
         if left <= 0:
             raise OutOfTime(f"not done in {seconds:.0f} s")
-        ready, _, _ = select.select([read], [], [], min(left, 1.0))
-        if not ready:
+        if not readable(read, min(left, 1.0)):
             continue
         chunk = os.read(read, 1 << 20)
         if not chunk:

@@ -1,7 +1,9 @@
 """What a bounded child runs (:mod:`.bounded`; forked here, by :mod:`.child_server`, or
-a fresh interpreter): the call under its memory bound, its answer pickled to its parent."""
+a fresh interpreter): the call under its memory bound, its answer pickled to its parent;
+and how the parent waits on it (:func:`readable`)."""
 import os
 import pickle
+import select
 import signal
 from collections.abc import Callable
 from typing import Any
@@ -54,3 +56,12 @@ def _address_space_used() -> int:
             return int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
     except (OSError, ValueError, IndexError):
         return 0
+
+
+def readable(fd: int, seconds: float | None) -> bool:
+    """Whether ``fd`` is readable (a pipe with data or closed, a pidfd whose process ended)
+    within ``seconds`` (None: wait as long as it takes). ``poll``, not ``select``: a
+    process with over 1,024 open files (a batch's threads) gets larger descriptors."""
+    poller = select.poll()
+    poller.register(fd, select.POLLIN)
+    return bool(poller.poll(None if seconds is None else int(seconds * 1000) + 1))

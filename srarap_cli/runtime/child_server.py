@@ -18,7 +18,6 @@ import functools
 import importlib
 import os
 import pickle
-import select
 import signal
 import socket
 import struct
@@ -28,7 +27,7 @@ import threading
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from .child_call import run_child
+from .child_call import readable, run_child
 
 #: the server's own program: no death signal tied to the thread that starts it (a pool
 #: thread that ends would kill it under a read another thread started); end of file on its
@@ -41,6 +40,7 @@ serve(int(sys.argv[1]))
 _HEAD = struct.Struct("!Q")
 _lock = threading.Lock()
 _server: tuple[subprocess.Popen, socket.socket] | None = None
+_failed = False
 
 
 @functools.cache
@@ -62,7 +62,8 @@ def start(func: Callable[..., Any], args: tuple, memory: int | None,
     """``func(*args)`` under :func:`.child_call.run_child` in a child the server forks, once
     the server has imported the modules ``preload`` names: the child's pidfd and the
     reading end of its result's pipe, or None where no server can run here."""
-    if not available():
+    global _failed
+    if _failed or not available():
         return None
     payload = pickle.dumps((tuple(preload), func, args, memory),
                            protocol=pickle.HIGHEST_PROTOCOL)
@@ -73,6 +74,9 @@ def start(func: Callable[..., Any], args: tuple, memory: int | None,
                 pidfd = _ask(_connection(retry), payload, write)
                 if pidfd is not None:
                     return pidfd, read
+            # twice in a row: it cannot run here (srarap not importable by a fresh
+            # interpreter, say); not tried again, each call starting two for nothing
+            _failed = True
     finally:
         os.close(write)
     os.close(read)
@@ -85,7 +89,7 @@ def reap(pidfd: int, kill: bool) -> None:
     try:
         if kill:
             signal.pidfd_send_signal(pidfd, signal.SIGKILL)
-        select.select([pidfd], [], [])
+        readable(pidfd, None)
     except OSError:  # ended already
         pass
     finally:
@@ -153,7 +157,7 @@ def serve(fd: int) -> None:
     children: set[int] = set()
     try:
         while True:
-            while children and not select.select([sock], [], [], 0.5)[0]:
+            while children and not readable(sock.fileno(), 0.5):
                 children -= _reaped(children)  # no zombie kept while it waits
             if (call := _receive(sock)) is None:
                 break
