@@ -3,7 +3,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from srarap_cli.solver.drivers.monitor import EXACT, STILL, WINDOW, Monitor
+from srarap_cli.solver.drivers.monitor import EPS, EXACT, STILL, WINDOW, Monitor
 
 
 def run(energies, *, tol=1e-6, moves=None, energy_scale=1.0):
@@ -61,11 +61,12 @@ def test_an_iterate_that_no_longer_moves_is_converged_whatever_its_energy_noise(
     which may sit above a tight tol's exact level: a solve whose last WINDOW steps moved
     nothing beyond rounding stops, converged; fewer such steps do not; tol 0 is a budget."""
     tiny = [2e-14, 1e-14, 3e-14, 1.5e-14]
-    still = [0.0] + [STILL / 2] * len(tiny)
+    unit = STILL * EPS  # one vertex here: the bound is STILL units of rounding of the size
+    still = [0.0] + [unit / 2] * len(tiny)
     assert run([1.0] + tiny, tol=1e-16, moves=still) == (WINDOW, True)
-    assert run([1.0] + tiny, tol=1e-16, moves=[0.0, 1e-4, STILL / 2, STILL / 2, 1e-4]) \
+    assert run([1.0] + tiny, tol=1e-16, moves=[0.0, 1e-4, unit / 2, unit / 2, 1e-4]) \
         == (None, False)
-    assert run([1.0] + tiny, tol=1e-16, moves=[0.0] + [2 * STILL] * len(tiny)) \
+    assert run([1.0] + tiny, tol=1e-16, moves=[0.0] + [2 * unit] * len(tiny)) \
         == (None, False)
     assert run([1.0] + tiny, tol=0.0, moves=still) == (None, False)
 
@@ -74,3 +75,22 @@ def test_a_large_move_keeps_the_run_going_however_little_the_energy_changed():
     energies = [1.0, 1.0, 1.0, 1.0]
     stopped, _ = run(energies, moves=[0.0, 0.1, 0.1, 0.1])
     assert stopped is None
+
+
+def test_the_rounding_a_still_step_may_show_grows_with_the_vertex_count():
+    """A Poisson solve's rounding grows with the mesh (n/1,700 units on n vertices,
+    measured): 300 units of rounding a step is still on 10,000 vertices (the bound is
+    n/25 = 400 units), not on one (64)."""
+    def stops(n):
+        m = Monitor(max_iter=20, tol=1e-16, energy_scale=1.0, scale=1.0)
+        x = np.zeros((n, 3))
+        previous = None
+        for k in range(WINDOW + 2):
+            x = x + [300 * EPS if k else 0.0, 0.0, 0.0]
+            state = SimpleNamespace(total=1e-14 * (1 + k % 2), membrane=0.0, bending=0.0,
+                                    positions=x)
+            if m.record(state, previous):
+                return m.converged
+            previous = state
+        return False
+    assert stops(10_000) and not stops(1)

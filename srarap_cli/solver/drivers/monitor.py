@@ -17,10 +17,15 @@ That energy has a floor, though: the rotors come out of their solves with errors
 1e-9, so an exactly rigid answer keeps a bending energy of 1e-17 (a 106-vertex tube) to 1e-14
 (Spot) of the scale, more on larger meshes, above ``tol * EXACT`` for a tol below about 1e-8;
 such a solve never stopped (a rigid motion asked to tol 1e-12 ran its 1000 iterations, exact
-from the first). So a solve whose last WINDOW steps each moved no vertex by more than
-:data:`STILL` of the mesh's size is converged too: its iterate no longer changes at the
-arithmetic's precision, and further steps only stir the rounding. A tol of 0 (a fixed
-budget) runs its budget.
+from the first). So a solve whose last WINDOW steps each moved no vertex by more than its
+rounding is converged too: its iterate no longer changes, and further steps only stir the
+rounding. That rounding grows with the mesh (the Poisson solve's conditioning): a rigid
+answer's steps moved vertices by about n/1,700 units of double rounding of the mesh's size
+on n vertices (1 on the 106-vertex tube, 5 on Spot, 60 on the 100k bar), so a step counts
+as still below :data:`STILL` units or n/25, whichever is more. Not much more: a converging
+solve to tol 1e-12 (the sample bar's twist) still moves vertices by 1e-10 of the size a
+step while it gains 1e-11 of its energy, and a bound there stopped it 12 steps early, 2.5e-10
+of the size short. A tol of 0 (a fixed budget) runs its budget.
 """
 import time
 from collections.abc import Callable
@@ -38,9 +43,10 @@ WINDOW = 3
 EXACT = 1e-6
 #: relative changes divide by at least this much of the rest shape's scale
 FLOOR = 1e-14
-#: steps that move no vertex by more than this much of the mesh's size leave it as it is, to
-#: the arithmetic's precision (64 units of double rounding)
-STILL = 64 * float(np.finfo(float).eps)
+#: steps that move no vertex by more than this many units of double rounding of the mesh's
+#: size (or n/25 on n vertices, where that is more) leave it as it is, but for rounding
+STILL = 64
+EPS = float(np.finfo(float).eps)
 
 
 def recent_changes(log: list[dict[str, Any]], key: str = "rel_change") -> list[float]:
@@ -66,7 +72,7 @@ class Monitor:
         more than ``sqrt(tol) * scale`` (an accelerated step can change the shape a lot while
         the energy barely changes); or when the energy is below ``tol * EXACT * energy_scale``;
         or (tol above 0) when the last WINDOW steps each moved no vertex by more than
-        ``STILL * scale``
+        ``max(STILL, n / 25) * EPS * scale`` on n vertices
     time_limit : float or None, stop (not converged) after this many seconds
     callback : callable(dict) or None, called with each log row
     energy_scale : float, the rest shape's ``sum c |q|^2``; relative changes divide by at
@@ -88,7 +94,8 @@ class Monitor:
                  scale: float = float("inf")) -> None:
         self.max_iter, self.tol, self.time_limit = max_iter, tol, time_limit
         self.move_tol = np.sqrt(max(tol, 0.0)) * scale
-        self.still_tol = STILL * scale if tol > 0 and np.isfinite(scale) else -1.0
+        self.still_unit = EPS * scale if tol > 0 and np.isfinite(scale) else -1.0
+        self.still_tol = -1.0  # set at the start, from the mesh's vertex count
         self.callback = callback
         self.energy_floor = FLOOR * energy_scale
         self.exact_energy = max(tol, 0.0) * EXACT * energy_scale
@@ -114,6 +121,7 @@ class Monitor:
             raise NumericalError(f"energy became non-finite at iteration {len(self.log)}")
         if previous is None:
             rel, move = float("nan"), 0.0
+            self.still_tol = max(STILL, len(state.positions) / 25) * self.still_unit
         else:
             last = self.log[-1]["total"]
             rel = abs(total - last) / max(abs(last), self.energy_floor)
