@@ -20,12 +20,12 @@ such a solve never stopped (a rigid motion asked to tol 1e-12 ran its 1000 itera
 from the first). So a solve whose last WINDOW steps each moved no vertex by more than its
 rounding is converged too: its iterate no longer changes, and further steps only stir the
 rounding. That rounding grows with the mesh (the Poisson solve's conditioning): a rigid
-answer's steps moved vertices by about n/1,700 units of double rounding of the mesh's size
-on n vertices (1 on the 106-vertex tube, 5 on Spot, 60 on the 100k bar), so a step counts
-as still below :data:`STILL` units or n/25, whichever is more. Not much more: a converging
-solve to tol 1e-12 (the sample bar's twist) still moves vertices by 1e-10 of the size a
-step while it gains 1e-11 of its energy, and a bound there stopped it 12 steps early, 2.5e-10
-of the size short. A tol of 0 (a fixed budget) runs its budget.
+answer's steps moved vertices by 1 unit of double rounding of the mesh's size on the
+106-vertex tube, 5 on Spot, 60 on the 100k bar and 94 on the 1.2M bar, so a step counts as
+still below :data:`STILL` units or n/25 on n vertices, whichever is more. Not much more: a
+converging solve to tol 1e-12 (the sample bar's twist) still moves vertices by 1e-10 of the
+size a step while it gains 1e-11 of its energy, and a bound there stopped it 12 steps
+early, 2.5e-10 of the size short. A tol of 0 (a fixed budget) runs its budget.
 """
 import time
 from collections.abc import Callable
