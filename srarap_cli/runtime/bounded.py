@@ -27,7 +27,7 @@ from functools import partial
 from typing import Any
 
 from . import child_server, forking
-from .child_call import readable, run_child
+from .child_call import imported, readable, run_child
 from .fresh_process import PRELUDE
 
 #: seconds a bounded call may take at least, and per megabyte of its input on top
@@ -87,7 +87,7 @@ def start_bounded(func: Callable[..., Any], *args: Any, seconds: float,
         pidfd, read = served
         return Pending(None, (None, read, end, seconds, partial(child_server.reap, pidfd)))
     if way == "fork":
-        child_server.imported(preload)
+        imported(preload)
     pid, read = (_fork if way == "fork" else _fresh)(func, args, memory)
     return Pending(None, (pid, read, end, seconds, partial(_reap, pid)))
 

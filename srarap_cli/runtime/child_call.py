@@ -1,11 +1,13 @@
 """What a bounded child runs (:mod:`.bounded`; forked here, by :mod:`.child_server`, or
 a fresh interpreter): the call under its memory bound, its answer pickled to its parent;
-and how the parent waits on it (:func:`readable`)."""
+what its forker imports first (:func:`imported`), and how the parent waits on it
+(:func:`readable`)."""
+import importlib
 import os
 import pickle
 import select
 import signal
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 
@@ -65,3 +67,13 @@ def readable(fd: int, seconds: float | None) -> bool:
     poller = select.poll()
     poller.register(fd, select.POLLIN)
     return bool(poller.poll(None if seconds is None else int(seconds * 1000) + 1))
+
+
+def imported(modules: Sequence[str]) -> None:
+    """Import ``modules`` here, so that a child forked later starts with them (one that
+    fails to import is left to the child, whose error then says why)."""
+    for name in modules:
+        try:
+            importlib.import_module(name)
+        except Exception:  # noqa: BLE001 -- the child meets it again and reports it
+            continue

@@ -15,7 +15,6 @@ died is started again at the next call. Where there is no pidfd, or the server c
 :func:`start` returns None and the caller starts a fresh interpreter for the call.
 """
 import functools
-import importlib
 import os
 import pickle
 import signal
@@ -27,7 +26,7 @@ import threading
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from .child_call import readable, run_child
+from .child_call import imported, readable, run_child
 
 #: the server's own program: no death signal tied to the thread that starts it (a pool
 #: thread that ends would kill it under a read another thread started); end of file on its
@@ -123,7 +122,7 @@ def _ask(sock: socket.socket | None, payload: bytes, write: int) -> int | None:
         socket.send_fds(sock, [_HEAD.pack(len(payload))], [write])
         sock.sendall(payload)
         answer, fds, _, _ = socket.recv_fds(sock, _HEAD.size, 1)
-    except OSError:
+    except OSError:  # the server died: the caller starts another and asks again
         return None
     if len(answer) == _HEAD.size and len(fds) == 1:
         return fds[0]
@@ -205,16 +204,6 @@ def _fork_child(sock: socket.socket, payload: bytes, write: int) -> int:
         run_child(write, func, args, memory)
     os.close(write)
     return pid
-
-
-def imported(modules: Sequence[str]) -> None:
-    """Import ``modules`` here, so that a child forked later starts with them (one that
-    fails to import is left to the child, whose error then says why)."""
-    for name in modules:
-        try:
-            importlib.import_module(name)
-        except Exception:  # noqa: BLE001 -- the child meets it again and reports it
-            continue
 
 
 def _raise(exc: BaseException) -> None:
